@@ -1,0 +1,49 @@
+#include "brick.h"
+
+#include <cmath>
+#include <limits>
+
+#include "error.h"
+
+namespace pvr::core {
+
+Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored)
+    : grid_(grid), type_(type), owned_(owned), stored_(stored) {
+  if (owned.empty() || !stored.contains(owned) || !grid.allNodes().contains(stored))
+    throw Error(ErrorCode::kInvalidArgument,
+                "brick: owned box " + toString(owned) + " must lie in stored box " +
+                    toString(stored) + " inside the grid " + toString(grid.allNodes()));
+  data_.resize(std::size_t(stored.nodeCount()) * scalarSize(type));
+}
+
+double Brick::valueAt(IVec3 node) const {
+  const std::size_t i = linearIndex(node);
+  return dispatchScalar(type_, [&](auto tag) {
+    using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+    return double(as<T>()[i]);
+  });
+}
+
+void Brick::updateValueRange() {
+  range_ = dispatchScalar(type_, [&](auto tag) {
+    using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+    const T* v = as<T>();
+    const std::size_t n = std::size_t(stored_.nodeCount());
+    double lo = std::numeric_limits<double>::infinity();
+    double hi = -lo;
+    std::uint64_t bad = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double x = double(v[i]);
+      if (!std::isfinite(x)) {
+        ++bad;
+        continue;
+      }
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+    if (lo > hi) lo = hi = 0;  // no finite voxel at all
+    return ValueRange{lo, hi, bad};
+  });
+}
+
+}  // namespace pvr::core

@@ -1,0 +1,79 @@
+// Brick: a box of the global grid's nodes held in memory, with ghost layers.
+//
+// `owned` is the box this brick renders (its cells lie between owned.lo and
+// owned.hi); `stored` is owned plus the ghost layers that trilinear
+// reconstruction and central differences need, clipped to the grid. A whole
+// volume is the brick whose owned and stored boxes are the whole grid.
+// Scalars keep their file type: a uint8 volume costs one byte per voxel.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "grid.h"
+
+namespace pvr::core {
+
+// The finite values of a brick. Non-finite voxels (NaN, Inf) are counted, not
+// ranged: they classify as empty wherever they are sampled.
+struct ValueRange {
+  double min = 0;
+  double max = 0;
+  std::uint64_t nonFinite = 0;
+};
+
+class Brick {
+ public:
+  Brick() = default;
+  // Zero-filled storage for `stored`; throws if stored does not contain owned
+  // or lies outside the grid.
+  Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored);
+
+  const GridGeometry& grid() const { return grid_; }
+  ScalarType type() const { return type_; }
+  const NodeBox& owned() const { return owned_; }
+  const NodeBox& stored() const { return stored_; }
+
+  std::byte* bytes() { return data_.data(); }
+  const std::byte* bytes() const { return data_.data(); }
+  std::size_t byteSize() const { return data_.size(); }
+  template <typename T> T* as() { return reinterpret_cast<T*>(data_.data()); }
+  template <typename T> const T* as() const { return reinterpret_cast<const T*>(data_.data()); }
+
+  // Linear index into storage of a global node inside `stored`.
+  std::size_t linearIndex(IVec3 node) const {
+    const IVec3 e = stored_.extents();
+    return std::size_t(((node.z - stored_.lo.z) * e.y + (node.y - stored_.lo.y)) * e.x +
+                       (node.x - stored_.lo.x));
+  }
+  // One voxel as double; for tests, references and set-up, not for hot loops.
+  double valueAt(IVec3 node) const;
+
+  // Recomputes the finite value range; loaders call it after filling storage.
+  void updateValueRange();
+  const ValueRange& valueRange() const { return range_; }
+
+ private:
+  GridGeometry grid_;
+  ScalarType type_ = ScalarType::kUInt8;
+  NodeBox owned_;
+  NodeBox stored_;
+  std::vector<std::byte> data_;
+  ValueRange range_;
+};
+
+// Calls f(static_cast<const T*>(nullptr)) with T the brick's C++ scalar type:
+// the one place a scalar type turns into a template argument.
+template <typename F>
+decltype(auto) dispatchScalar(ScalarType type, F&& f) {
+  switch (type) {
+    case ScalarType::kUInt8: return f(static_cast<const std::uint8_t*>(nullptr));
+    case ScalarType::kUInt16: return f(static_cast<const std::uint16_t*>(nullptr));
+    case ScalarType::kInt16: return f(static_cast<const std::int16_t*>(nullptr));
+    case ScalarType::kFloat32: break;
+  }
+  return f(static_cast<const float*>(nullptr));
+}
+
+}  // namespace pvr::core

@@ -1,0 +1,60 @@
+// Opening volumes: files of every registered format and procedural volumes.
+//
+// A VolumeSource knows a volume's grid and scalar type after reading only
+// its header, and reads any box of nodes on demand. Raw-encoded files read a
+// box without touching the rest of the file (rank r of an MPI job reads only
+// its brick plus ghosts); other encodings (gzip) read the whole and crop,
+// and say so through canReadPartially() so a caller can read once and scatter.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "../brick.h"
+
+namespace pvr::core {
+
+class VolumeSource {
+ public:
+  virtual ~VolumeSource() = default;
+  virtual const GridGeometry& grid() const = 0;
+  virtual ScalarType type() const = 0;
+  // True when readBox costs I/O proportional to the box, not the volume.
+  virtual bool canReadPartially() const = 0;
+  // The nodes of `stored` (which must contain `owned` and lie in the grid)
+  // as a brick that renders `owned`. Throws pvr::Error naming the file.
+  virtual Brick readBox(const NodeBox& owned, const NodeBox& stored) const = 0;
+  // A short description for logs and catalogs ("ct.nhdr: 256x256x108 int16").
+  virtual std::string describe() const = 0;
+
+  Brick readAll() const { return readBox(grid().allNodes(), grid().allNodes()); }
+};
+
+// A file format: `matches` looks at the path (extension), `open` reads the
+// header and validates it against the data's byte count.
+struct VolumeFormat {
+  const char* name;
+  bool (*matches)(const std::string& path);
+  std::unique_ptr<VolumeSource> (*open)(const std::string& path);
+};
+
+// Every registered format, in the order they are tried (volume_formats.cpp).
+const std::vector<VolumeFormat>& volumeFormats();
+
+// Opens a volume file by its extension. Throws pvr::Error naming the file and
+// what is wrong (missing, unreadable header, unknown type, truncated data,
+// dims that do not match the byte count).
+std::unique_ptr<VolumeSource> openVolumeFile(const std::string& path);
+
+// Procedural volumes by name, any resolution, float32 values:
+//   "shepp-logan"     3D Shepp-Logan head phantom (Kak & Slaney ellipsoids), values in [0, 1]
+//   "marschner-lobb"  the Marschner-Lobb test signal (f_M = 6, alpha = 0.25) on [-1,1]^3, values in [0, 1]
+//   "constant-slab"   1.0 everywhere (a homogeneous slab; exact references exist)
+// The grid spans [-1, 1] on its longest axis with isotropic spacing unless
+// `spacing` is given. Throws pvr::Error for an unknown name.
+std::unique_ptr<VolumeSource> openProcedural(const std::string& name, IVec3 dims);
+std::unique_ptr<VolumeSource> openProcedural(const std::string& name, IVec3 dims, Vec3 spacing);
+std::vector<std::string> proceduralNames();
+
+}  // namespace pvr::core
