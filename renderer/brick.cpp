@@ -1,6 +1,7 @@
 #include "brick.h"
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "error.h"
@@ -44,6 +45,23 @@ void Brick::updateValueRange() {
     if (lo > hi) lo = hi = 0;  // no finite voxel at all
     return ValueRange{lo, hi, bad};
   });
+}
+
+Brick cropBrick(const Brick& source, const NodeBox& owned, int ghostLayers) {
+  const NodeBox stored = owned.grown(ghostLayers).intersect(source.grid().allNodes());
+  if (!source.stored().contains(stored))
+    throw Error(ErrorCode::kInvalidArgument, "cropBrick: " + toString(stored) +
+                                                 " is not inside the source brick " +
+                                                 toString(source.stored()));
+  Brick out(source.grid(), source.type(), owned, stored);
+  const std::size_t size = scalarSize(source.type());
+  const std::size_t rowBytes = std::size_t(stored.extent(0)) * size;
+  for (std::int64_t z = stored.lo.z; z <= stored.hi.z; ++z)
+    for (std::int64_t y = stored.lo.y; y <= stored.hi.y; ++y)
+      std::memcpy(out.bytes() + out.linearIndex({stored.lo.x, y, z}) * size,
+                  source.bytes() + source.linearIndex({stored.lo.x, y, z}) * size, rowBytes);
+  out.updateValueRange();
+  return out;
 }
 
 }  // namespace pvr::core

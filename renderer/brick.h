@@ -63,6 +63,10 @@ class Brick {
   ValueRange range_;
 };
 
+// The part of `source` that a brick owning `owned` with `ghostLayers` layers
+// around it stores (clipped to the grid). `source` must store all of it.
+Brick cropBrick(const Brick& source, const NodeBox& owned, int ghostLayers);
+
 // Calls f(static_cast<const T*>(nullptr)) with T the brick's C++ scalar type:
 // the one place a scalar type turns into a template argument.
 template <typename F>

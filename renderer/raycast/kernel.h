@@ -1,0 +1,261 @@
+// The per-ray kernel: march one ray through one brick.
+//
+// Templated on the scalar type, shading and pre-integration, so the loop
+// over samples branches on no configuration, allocates nothing and takes no
+// lock. Everything a ray needs that does not change per ray lives in
+// KernelParams, set up once per frame by raycaster.cpp.
+#pragma once
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <type_traits>
+
+#include "../image.h"
+
+namespace pvr::core {
+
+struct KernelParams {
+  // Voxels of the stored box; index(i,j,k) = i*1 + j*strideY + k*strideZ + base.
+  const void* voxels = nullptr;
+  std::int64_t strideY = 0, strideZ = 0, base = 0;
+  // Owned box in index units, for membership: lo <= u < hi, or u <= hi where
+  // the box meets the far edge of the grid (hiClosed).
+  double ownLo[3], ownHi[3];
+  bool hiClosed[3];
+  // Cell clamps: a sample's cell index is clamped into [cellLo, cellHi]; the
+  // owned clamp for samples, the stored clamp for reads around them.
+  int ownCellLo[3], ownCellHi[3];
+  int storedCellLo[3], storedCellHi[3];
+  float domainMax[3];  // dims - 1: positions read around a sample stay in the domain
+  float invSpacing[3];  // 1 / spacing, for world-space gradients
+  // Macrocells.
+  const std::uint8_t* visible = nullptr;
+  int mcFirst[3], mcCount[3];
+  // Classification.
+  const Rgba* table = nullptr;  // TransferTable or PreintegratedTable entries
+  int tableEntries = 0;
+  float tableScale = 0, tableOffset = 0;
+  float earlyTermination = 1;
+  // Shading (world space).
+  float ambient = 0, diffuse = 0, specular = 0, shininess = 1;
+};
+
+// One ray in the brick's index space: u(k) = origin + k * step.
+struct RaySetup {
+  double origin[3];
+  double step[3];
+  float light[3];     // unit vector towards the light, world space
+  float halfway[3];   // Blinn-Phong half vector, world space
+};
+
+struct RayResult {
+  Rgba colour;
+  std::uint64_t samples = 0;
+  bool hit = false;
+};
+
+namespace kernel {
+
+template <typename T>
+inline float trilinear(const T* v, const KernelParams& p, float u0, float u1, float u2,
+                       const int* cellLo, const int* cellHi) {
+  const int i = std::clamp(int(u0), cellLo[0], cellHi[0]);
+  const int j = std::clamp(int(u1), cellLo[1], cellHi[1]);
+  const int k = std::clamp(int(u2), cellLo[2], cellHi[2]);
+  const float fx = u0 - float(i), fy = u1 - float(j), fz = u2 - float(k);
+  const T* c = v + (p.base + i + j * p.strideY + k * p.strideZ);
+  const std::int64_t sy = p.strideY, sz = p.strideZ;
+  const float c00 = float(c[0]) + fx * (float(c[1]) - float(c[0]));
+  const float c10 = float(c[sy]) + fx * (float(c[sy + 1]) - float(c[sy]));
+  const float c01 = float(c[sz]) + fx * (float(c[sz + 1]) - float(c[sz]));
+  const float c11 = float(c[sz + sy]) + fx * (float(c[sz + sy + 1]) - float(c[sz + sy]));
+  const float c0 = c00 + fy * (c10 - c00);
+  const float c1 = c01 + fy * (c11 - c01);
+  return c0 + fz * (c1 - c0);
+}
+
+// A value read around a sample (gradient or pre-integration back end):
+// clamped into the domain, from anywhere in the stored box.
+template <typename T>
+inline float around(const T* v, const KernelParams& p, float u0, float u1, float u2) {
+  return trilinear(v, p, std::clamp(u0, 0.0f, p.domainMax[0]), std::clamp(u1, 0.0f, p.domainMax[1]),
+                   std::clamp(u2, 0.0f, p.domainMax[2]), p.storedCellLo, p.storedCellHi);
+}
+
+template <typename T>
+inline bool finite(float s) {
+  if constexpr (std::is_floating_point_v<T>) return std::fabs(s) <= FLT_MAX;
+  return true;
+}
+
+inline Rgba lerp(const Rgba& a, const Rgba& b, float w) {
+  return {a.r + w * (b.r - a.r), a.g + w * (b.g - a.g), a.b + w * (b.b - a.b), a.a + w * (b.a - a.a)};
+}
+
+inline Rgba classify1D(const KernelParams& p, float s) {
+  const float x = std::clamp(s * p.tableScale + p.tableOffset, 0.0f, float(p.tableEntries - 1));
+  const int i = std::min(int(x), p.tableEntries - 2);
+  return lerp(p.table[i], p.table[i + 1], x - float(i));
+}
+
+inline Rgba classify2D(const KernelParams& p, float front, float back) {
+  const int n = p.tableEntries;
+  const float x = std::clamp(front * p.tableScale + p.tableOffset, 0.0f, float(n - 1));
+  const float y = std::clamp(back * p.tableScale + p.tableOffset, 0.0f, float(n - 1));
+  const int i = std::min(int(x), n - 2), j = std::min(int(y), n - 2);
+  const Rgba* row0 = p.table + std::int64_t(i) * n;
+  const Rgba* row1 = row0 + n;
+  const float wy = y - float(j);
+  return lerp(lerp(row0[j], row0[j + 1], wy), lerp(row1[j], row1[j + 1], wy), x - float(i));
+}
+
+// Blinn-Phong with a central-difference gradient, two-sided. A zero or
+// undefined gradient (homogeneous or non-finite data) is lit head-on.
+template <typename T>
+inline Rgba shade(const T* v, const KernelParams& p, const RaySetup& ray, float u0, float u1,
+                  float u2, Rgba c) {
+  float g[3];
+  const float u[3] = {u0, u1, u2};
+  for (int a = 0; a < 3; ++a) {
+    float up[3] = {u0, u1, u2}, dn[3] = {u0, u1, u2};
+    up[a] = std::min(u[a] + 1.0f, p.domainMax[a]);
+    dn[a] = std::max(u[a] - 1.0f, 0.0f);
+    const float dist = up[a] - dn[a];
+    const float diff = around(v, p, up[0], up[1], up[2]) - around(v, p, dn[0], dn[1], dn[2]);
+    g[a] = dist > 0 ? diff / dist * p.invSpacing[a] : 0.0f;
+  }
+  const float gg = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+  float lit = p.ambient + p.diffuse;
+  float spec = 0;
+  if (gg > 1e-20f && gg <= FLT_MAX) {
+    const float inv = 1.0f / std::sqrt(gg);
+    const float nl = std::fabs((g[0] * ray.light[0] + g[1] * ray.light[1] + g[2] * ray.light[2]) * inv);
+    const float nh = std::fabs((g[0] * ray.halfway[0] + g[1] * ray.halfway[1] + g[2] * ray.halfway[2]) * inv);
+    lit = p.ambient + p.diffuse * nl;
+    spec = p.specular * std::pow(nh, p.shininess) * c.a;
+  }
+  return {c.r * lit + spec, c.g * lit + spec, c.b * lit + spec, c.a};
+}
+
+// Exact membership of sample k in the owned box (see KernelParams).
+inline bool inside(const KernelParams& p, const RaySetup& r, std::int64_t k) {
+  for (int a = 0; a < 3; ++a) {
+    const double u = r.origin[a] + double(k) * r.step[a];
+    if (!(u >= p.ownLo[a])) return false;
+    if (p.hiClosed[a] ? !(u <= p.ownHi[a]) : !(u < p.ownHi[a])) return false;
+  }
+  return true;
+}
+
+// The samples [first, last] of this ray inside the owned box; false if none.
+inline bool sampleRange(const KernelParams& p, const RaySetup& r, std::int64_t& first,
+                        std::int64_t& last) {
+  double kmin = 0, kmax = 1e18;
+  for (int a = 0; a < 3; ++a) {
+    if (r.step[a] == 0) {
+      if (r.origin[a] < p.ownLo[a] || r.origin[a] > p.ownHi[a]) return false;
+      continue;
+    }
+    double k0 = (p.ownLo[a] - r.origin[a]) / r.step[a];
+    double k1 = (p.ownHi[a] - r.origin[a]) / r.step[a];
+    if (k0 > k1) std::swap(k0, k1);
+    kmin = std::max(kmin, k0);
+    kmax = std::min(kmax, k1);
+  }
+  if (kmin > kmax + 2) return false;
+  // The estimate is within a sample or two; the exact test decides.
+  first = std::max<std::int64_t>(0, std::int64_t(std::ceil(kmin)) - 2);
+  last = std::int64_t(std::floor(kmax)) + 2;
+  while (first <= last && !inside(p, r, first)) ++first;
+  if (first > last) return false;
+  while (!inside(p, r, last)) --last;
+  while (inside(p, r, last + 1)) ++last;
+  while (first > 0 && inside(p, r, first - 1)) --first;
+  return true;
+}
+
+// The first sample index at or after the ray leaves macrocell m (whose
+// global index on each axis is m[a]); never less than k + 1.
+inline std::int64_t macrocellExit(const RaySetup& r, const int* m, std::int64_t k, int shift) {
+  double exitK = 1e18;
+  for (int a = 0; a < 3; ++a) {
+    if (r.step[a] > 0) exitK = std::min(exitK, (double(std::int64_t(m[a] + 1) << shift) - r.origin[a]) / r.step[a]);
+    else if (r.step[a] < 0) exitK = std::min(exitK, (double(std::int64_t(m[a]) << shift) - r.origin[a]) / r.step[a]);
+  }
+  return std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(exitK)));
+}
+
+}  // namespace kernel
+
+template <typename T, bool kShaded, bool kPreintegrated>
+RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
+  RayResult out;
+  std::int64_t first, last;
+  if (!kernel::sampleRange(p, ray, first, last)) return out;
+  out.hit = true;
+
+  const T* v = static_cast<const T*>(p.voxels);
+  const float o0 = float(ray.origin[0]), o1 = float(ray.origin[1]), o2 = float(ray.origin[2]);
+  const float d0 = float(ray.step[0]), d1 = float(ray.step[1]), d2 = float(ray.step[2]);
+  Rgba acc;
+  std::int64_t done = first;  // next sample not yet composited or skipped
+  std::int64_t k = first;
+  while (k <= last) {
+    // Which macrocell holds sample k, and where does the ray leave it?
+    const float u0 = o0 + float(k) * d0, u1 = o1 + float(k) * d1, u2 = o2 + float(k) * d2;
+    int m[3] = {std::clamp(int(u0) >> mcShift, p.mcFirst[0], p.mcFirst[0] + p.mcCount[0] - 1),
+                std::clamp(int(u1) >> mcShift, p.mcFirst[1], p.mcFirst[1] + p.mcCount[1] - 1),
+                std::clamp(int(u2) >> mcShift, p.mcFirst[2], p.mcFirst[2] + p.mcCount[2] - 1)};
+    const std::int64_t exit = std::min(last + 1, kernel::macrocellExit(ray, m, k, mcShift));
+    const std::size_t mc = std::size_t(((m[2] - p.mcFirst[2]) * p.mcCount[1] + (m[1] - p.mcFirst[1])) *
+                                           p.mcCount[0] + (m[0] - p.mcFirst[0]));
+    if (!p.visible[mc]) {
+      k = exit;
+      continue;
+    }
+    // A pre-integrated segment runs from one sample to the next: when the
+    // sample before this macrocell was skipped, its segment ends in here.
+    std::int64_t start = k;
+    if constexpr (kPreintegrated) start = (done < k) ? std::max(first, k - 1) : k;
+
+    float front = 0;
+    if constexpr (kPreintegrated) {
+      front = kernel::around(v, p, o0 + float(start) * d0, o1 + float(start) * d1, o2 + float(start) * d2);
+    }
+    for (std::int64_t s = start; s < exit; ++s) {
+      const float x0 = o0 + float(s) * d0, x1 = o1 + float(s) * d1, x2 = o2 + float(s) * d2;
+      Rgba c;
+      if constexpr (kPreintegrated) {
+        const float back = kernel::around(v, p, x0 + d0, x1 + d1, x2 + d2);
+        const bool ok = kernel::finite<T>(front) && kernel::finite<T>(back);
+        c = ok ? kernel::classify2D(p, front, back) : Rgba{};
+        front = back;
+      } else {
+        const float value = kernel::trilinear(v, p, x0, x1, x2, p.ownCellLo, p.ownCellHi);
+        c = kernel::finite<T>(value) ? kernel::classify1D(p, value) : Rgba{};
+      }
+      ++out.samples;
+      if constexpr (kShaded) {
+        if (!(c.a > 0)) continue;
+        c = kernel::shade(v, p, ray, x0, x1, x2, c);
+      }
+      const float t = 1.0f - acc.a;
+      acc.r += t * c.r;
+      acc.g += t * c.g;
+      acc.b += t * c.b;
+      acc.a += t * c.a;
+      if (acc.a >= p.earlyTermination) {
+        out.colour = acc;
+        return out;
+      }
+    }
+    done = exit;
+    k = exit;
+  }
+  out.colour = acc;
+  return out;
+}
+
+}  // namespace pvr::core

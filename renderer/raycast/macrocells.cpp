@@ -1,0 +1,71 @@
+#include "macrocells.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pvr::core {
+
+MacrocellGrid::MacrocellGrid(const Brick& brick) {
+  const NodeBox& own = brick.owned();
+  const NodeBox& st = brick.stored();
+  for (int a = 0; a < 3; ++a) {
+    // Cells owned run from own.lo to own.hi - 1 (at least one cell unless the
+    // grid is one node thick on this axis).
+    const std::int64_t lastCell = std::max(own.lo[a], own.hi[a] - 1);
+    first_[a] = own.lo[a] >> kShift;
+    count_[a] = (lastCell >> kShift) - first_[a] + 1;
+  }
+  const std::size_t n = std::size_t(count_.product());
+  min_.assign(n, std::numeric_limits<float>::infinity());
+  max_.assign(n, -std::numeric_limits<float>::infinity());
+  visible_.assign(n, 1);
+
+  dispatchScalar(brick.type(), [&](auto tag) {
+    using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+    const T* v = brick.as<T>();
+    // Each stored node widens every macrocell whose dilated node range
+    // [kSize*m - 1, kSize*m + kSize + 1] holds it: at most two per axis.
+    auto cellsOf = [&](int a, std::int64_t node, std::int64_t& m0, std::int64_t& m1) {
+      // m0 = ceil((node - kSize - 1) / kSize), m1 = floor((node + 1) / kSize);
+      // >> floors negative numbers too.
+      m0 = std::max<std::int64_t>(first_[a], (node - 2) >> kShift);
+      m1 = std::min<std::int64_t>(first_[a] + count_[a] - 1, (node + 1) >> kShift);
+    };
+    for (std::int64_t z = st.lo.z; z <= st.hi.z; ++z) {
+      std::int64_t mz0, mz1;
+      cellsOf(2, z, mz0, mz1);
+      for (std::int64_t y = st.lo.y; y <= st.hi.y; ++y) {
+        std::int64_t my0, my1;
+        cellsOf(1, y, my0, my1);
+        const T* rowp = v + brick.linearIndex({st.lo.x, y, z});
+        for (std::int64_t x = st.lo.x; x <= st.hi.x; ++x) {
+          const float val = float(rowp[x - st.lo.x]);
+          if (!std::isfinite(val)) continue;
+          std::int64_t mx0, mx1;
+          cellsOf(0, x, mx0, mx1);
+          for (std::int64_t mz = mz0; mz <= mz1; ++mz)
+            for (std::int64_t my = my0; my <= my1; ++my)
+              for (std::int64_t mx = mx0; mx <= mx1; ++mx) {
+                const std::size_t i = std::size_t(((mz - first_.z) * count_.y + (my - first_.y)) *
+                                                      count_.x + (mx - first_.x));
+                min_[i] = std::min(min_[i], val);
+                max_[i] = std::max(max_[i], val);
+              }
+        }
+      }
+    }
+    return 0;
+  });
+}
+
+void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty) {
+  for (std::size_t i = 0; i < visible_.size(); ++i)
+    visible_[i] = !skipEmpty || (min_[i] <= max_[i] && table.anyVisible(min_[i], max_[i]));
+}
+
+std::size_t MacrocellGrid::visibleCount() const {
+  return std::size_t(std::count(visible_.begin(), visible_.end(), std::uint8_t(1)));
+}
+
+}  // namespace pvr::core

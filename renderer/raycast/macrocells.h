@@ -1,0 +1,44 @@
+// Min-max macrocells for empty-space skipping.
+//
+// The grid's cells are grouped into macrocells of kSize^3 cells, aligned to
+// the global grid (macrocell m covers cells [kSize*m, kSize*m + kSize)), so
+// a brick and the whole volume skip the same space. Each macrocell keeps the
+// finite min and max of the nodes its samples can read, widened by one node
+// on every side: a sample that rounding places in a neighbouring macrocell
+// still lies inside that neighbour's range. Classification against a
+// transfer function is one O(1) query per macrocell, cheap enough to redo on
+// every transfer-function change.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "../brick.h"
+#include "../transfer.h"
+
+namespace pvr::core {
+
+class MacrocellGrid {
+ public:
+  static constexpr int kShift = 3;
+  static constexpr int kSize = 1 << kShift;  // cells per macrocell edge
+
+  MacrocellGrid() = default;
+  explicit MacrocellGrid(const Brick& brick);
+
+  // Marks each macrocell visible if the transfer function gives some value
+  // in its range a non-zero opacity; all visible when skipping is off.
+  void classify(const TransferTable& table, bool skipEmpty);
+
+  IVec3 first() const { return first_; }    // global index of the brick's first macrocell
+  IVec3 count() const { return count_; }    // macrocells per axis
+  const std::uint8_t* visible() const { return visible_.data(); }
+  std::size_t visibleCount() const;
+
+ private:
+  IVec3 first_, count_;
+  std::vector<float> min_, max_;
+  std::vector<std::uint8_t> visible_;
+};
+
+}  // namespace pvr::core

@@ -1,0 +1,69 @@
+// The per-brick ray caster.
+//
+// A BrickRenderer renders one brick (a whole volume is one brick) into the
+// screen rectangle its owned box projects to. Samples lie at t = k * h along
+// each camera ray, the same for every brick, and a sample belongs to exactly
+// one brick (owned boxes are half-open where bricks meet), so bricks
+// rendered apart and composited front to back equal the whole.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "../brick.h"
+#include "../camera.h"
+#include "../image.h"
+#include "../scene.h"
+#include "../thread_pool.h"
+#include "../transfer.h"
+#include "macrocells.h"
+
+namespace pvr::core {
+
+struct RenderOptions {
+  double step = 0;              // world length h, > 0
+  double earlyTermination = 1;  // stop a ray once its opacity reaches this; 1 = off
+  bool preintegrated = false;
+  bool skipEmpty = true;        // macrocell empty-space skipping
+  ShadingSpec shading;
+};
+
+RenderOptions renderOptionsFor(const Scene& resolvedScene);
+
+// Ghost layers a brick needs beyond its owned box for these options:
+// trilinear sampling needs none (neighbours share the face nodes), central
+// differences one, a pre-integrated segment reaches one step beyond.
+int ghostLayers(const GridGeometry& grid, const RenderOptions& options);
+
+struct RenderStats {
+  std::uint64_t rays = 0;     // rays that met the brick
+  std::uint64_t samples = 0;  // samples reconstructed and classified
+  double seconds = 0;
+};
+
+class BrickRenderer {
+ public:
+  // Builds the macrocell grid; the brick must outlive the renderer.
+  explicit BrickRenderer(const Brick& brick);
+
+  // (Re)builds the classification tables and macrocell visibility. Cheap;
+  // call on every transfer-function, step or skipping change.
+  void classify(const TransferFunctionSpec& tf, const RenderOptions& options);
+
+  // Renders the brick's screen rectangle. `options` must match the last
+  // classify() in step and pre-integration.
+  Image render(const Camera& camera, const RenderOptions& options, ThreadPool& pool,
+               RenderStats* stats = nullptr) const;
+
+  const Brick& brick() const { return brick_; }
+  const MacrocellGrid& macrocells() const { return macrocells_; }
+
+ private:
+  const Brick& brick_;
+  MacrocellGrid macrocells_;
+  TransferTable table_;
+  std::unique_ptr<PreintegratedTable> preintegrated_;
+  double classifiedStep_ = 0;
+};
+
+}  // namespace pvr::core

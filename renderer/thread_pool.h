@@ -1,0 +1,47 @@
+// A fixed pool of worker threads running index-parallel loops.
+//
+// parallelFor hands out indices through one atomic counter, so tiles that
+// are cheap (empty space) and tiles that are dear (dense data) balance
+// themselves. The calling thread works too; workers sleep between loops.
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace pvr::core {
+
+class ThreadPool {
+ public:
+  // threads <= 0: one per hardware thread.
+  explicit ThreadPool(int threads = 0);
+  ~ThreadPool();
+  ThreadPool(const ThreadPool&) = delete;
+  ThreadPool& operator=(const ThreadPool&) = delete;
+
+  int size() const { return int(workers_.size()) + 1; }
+
+  // Calls body(index, worker) for every index in [0, count), worker in
+  // [0, size()). Returns when all are done; rethrows the first exception.
+  void parallelFor(std::size_t count, const std::function<void(std::size_t, int)>& body);
+
+ private:
+  void workerLoop(int worker);
+  void runShare(int worker);
+
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable wake_, done_;
+  const std::function<void(std::size_t, int)>* body_ = nullptr;
+  std::size_t count_ = 0;
+  std::size_t next_ = 0;        // guarded by mutex_ for hand-out
+  std::size_t generation_ = 0;  // bumps once per loop
+  int busy_ = 0;
+  bool stop_ = false;
+  std::exception_ptr error_;
+};
+
+}  // namespace pvr::core

@@ -1,0 +1,76 @@
+// Classified transfer functions: the tables the ray caster looks up.
+//
+// A TransferTable samples the piecewise-linear transfer function at kEntries
+// scalars across its control points and stores, per entry, the premultiplied
+// colour and the opacity of ONE ray step h: alpha = 1 - (1 - a)^(h / unit).
+// Outside the control points the function is clamped, so the table domain is
+// the control-point range and never depends on the data: every brick of a
+// split classifies a scalar identically. A last extra entry is transparent;
+// non-finite scalars index it.
+//
+// A PreintegratedTable holds, for pairs (s_front, s_back) of the scalars at
+// the ends of a ray segment of length h, the colour and opacity of that
+// segment with the scalar varying linearly along it (Engel et al. 2001),
+// integrated with self-attenuation, so sharp transfer functions stay
+// accurate at large steps.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "image.h"
+#include "scene.h"
+
+namespace pvr::core {
+
+// Extinction and colour of a transfer function at one scalar, in double:
+// the continuous model that references integrate and tables sample.
+struct Medium {
+  double r = 0, g = 0, b = 0;  // linear colour, not premultiplied
+  double tau = 0;              // extinction per world unit: -ln(1 - a) / unit_distance
+};
+Medium evaluateMedium(const TransferFunctionSpec& tf, double scalar);
+
+class TransferTable {
+ public:
+  static constexpr int kEntries = 4096;
+
+  TransferTable() = default;
+  TransferTable(const TransferFunctionSpec& tf, double step);
+
+  // Table coordinate of a scalar: scalar * scale + offset, in [0, kEntries-1].
+  float scale() const { return scale_; }
+  float offset() const { return offset_; }
+  const Rgba* entries() const { return entries_.data(); }  // kEntries + 1 entries
+  static constexpr int kTransparentIndex = kEntries;
+
+  // True if some scalar in [lo, hi] has non-zero opacity. O(1) (prefix sums).
+  bool anyVisible(double lo, double hi) const;
+  double scalarMin() const { return smin_; }
+  double scalarMax() const { return smax_; }
+
+ private:
+  double smin_ = 0, smax_ = 0;
+  float scale_ = 0, offset_ = 0;
+  std::vector<Rgba> entries_;
+  std::vector<std::uint32_t> visiblePrefix_;  // visiblePrefix_[i] = visible entries below i
+};
+
+class PreintegratedTable {
+ public:
+  static constexpr int kEntries = 256;
+
+  PreintegratedTable() = default;
+  PreintegratedTable(const TransferFunctionSpec& tf, double step);
+
+  float scale() const { return scale_; }
+  float offset() const { return offset_; }
+  // Row-major [front][back], kEntries x kEntries.
+  const Rgba* entries() const { return entries_.data(); }
+
+ private:
+  float scale_ = 0, offset_ = 0;
+  std::vector<Rgba> entries_;
+};
+
+}  // namespace pvr::core
