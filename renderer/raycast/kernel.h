@@ -46,6 +46,7 @@ struct KernelParams {
 struct RaySetup {
   double origin[3];
   double step[3];
+  double invStep[3];  // 1 / step (0 where step is 0): macrocell exits without division
   float light[3];     // unit vector towards the light, world space
   float halfway[3];   // Blinn-Phong half vector, world space
 };
@@ -176,15 +177,47 @@ inline bool sampleRange(const KernelParams& p, const RaySetup& r, std::int64_t& 
   return true;
 }
 
-// The first sample index at or after the ray leaves macrocell m (whose
-// global index on each axis is m[a]); never less than k + 1.
-inline std::int64_t macrocellExit(const RaySetup& r, const int* m, std::int64_t k, int shift) {
-  double exitK = 1e18;
+// Where the ray leaves the run of visible macrocells that holds sample k,
+// and the first sample at or after that exit (never less than k + 1).
+// `m` is the macrocell of sample k; *visible tells whether it was visible.
+// Walking macrocell to macrocell (a 3D DDA) until the visibility changes
+// turns a long visible stretch into one uninterrupted sample loop.
+inline std::int64_t runExit(const KernelParams& p, const RaySetup& r, int m[3], std::int64_t k,
+                            std::int64_t last, int shift, bool& visible) {
+  auto index = [&](const int* c) {
+    return std::size_t(((c[2] - p.mcFirst[2]) * p.mcCount[1] + (c[1] - p.mcFirst[1])) * p.mcCount[0] +
+                       (c[0] - p.mcFirst[0]));
+  };
+  visible = p.visible[index(m)];
+  // Sample index at which the ray crosses the next macrocell face on each axis.
+  double next[3];
+  double delta[3];
+  int stepDir[3];
   for (int a = 0; a < 3; ++a) {
-    if (r.step[a] > 0) exitK = std::min(exitK, (double(std::int64_t(m[a] + 1) << shift) - r.origin[a]) / r.step[a]);
-    else if (r.step[a] < 0) exitK = std::min(exitK, (double(std::int64_t(m[a]) << shift) - r.origin[a]) / r.step[a]);
+    if (r.step[a] > 0) {
+      stepDir[a] = 1;
+      next[a] = (double(std::int64_t(m[a] + 1) << shift) - r.origin[a]) * r.invStep[a];
+      delta[a] = double(1 << shift) * r.invStep[a];
+    } else if (r.step[a] < 0) {
+      stepDir[a] = -1;
+      next[a] = (double(std::int64_t(m[a]) << shift) - r.origin[a]) * r.invStep[a];
+      delta[a] = -double(1 << shift) * r.invStep[a];
+    } else {
+      stepDir[a] = 0;
+      next[a] = 1e18;
+      delta[a] = 0;
+    }
   }
-  return std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(exitK)));
+  for (;;) {
+    const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+    const double exitK = next[a];
+    const std::int64_t exit = std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(exitK)));
+    if (exit > last) return last + 1;
+    m[a] += stepDir[a];
+    if (m[a] < p.mcFirst[a] || m[a] >= p.mcFirst[a] + p.mcCount[a]) return exit;
+    if (bool(p.visible[index(m)]) != visible) return exit;
+    next[a] += delta[a];
+  }
 }
 
 }  // namespace kernel
@@ -203,15 +236,15 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
   std::int64_t done = first;  // next sample not yet composited or skipped
   std::int64_t k = first;
   while (k <= last) {
-    // Which macrocell holds sample k, and where does the ray leave it?
+    // Which macrocell holds sample k, and where does its run of equally
+    // visible macrocells end?
     const float u0 = o0 + float(k) * d0, u1 = o1 + float(k) * d1, u2 = o2 + float(k) * d2;
     int m[3] = {std::clamp(int(u0) >> mcShift, p.mcFirst[0], p.mcFirst[0] + p.mcCount[0] - 1),
                 std::clamp(int(u1) >> mcShift, p.mcFirst[1], p.mcFirst[1] + p.mcCount[1] - 1),
                 std::clamp(int(u2) >> mcShift, p.mcFirst[2], p.mcFirst[2] + p.mcCount[2] - 1)};
-    const std::int64_t exit = std::min(last + 1, kernel::macrocellExit(ray, m, k, mcShift));
-    const std::size_t mc = std::size_t(((m[2] - p.mcFirst[2]) * p.mcCount[1] + (m[1] - p.mcFirst[1])) *
-                                           p.mcCount[0] + (m[0] - p.mcFirst[0]));
-    if (!p.visible[mc]) {
+    bool visible;
+    const std::int64_t exit = kernel::runExit(p, ray, m, k, last, mcShift, visible);
+    if (!visible) {
       k = exit;
       continue;
     }

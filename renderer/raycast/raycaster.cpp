@@ -137,6 +137,7 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
         for (int a = 0; a < 3; ++a) {
           s.origin[a] = (ray.origin[a] - grid.origin[a]) / grid.spacing[a];
           s.step[a] = ray.direction[a] * options.step / grid.spacing[a];
+          s.invStep[a] = s.step[a] != 0 ? 1.0 / s.step[a] : 0.0;
         }
         // Headlight by default: the light direction is fixed in camera space.
         // The viewer looks back along the ray.
