@@ -14,7 +14,7 @@ Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, co
     throw Error(ErrorCode::kInvalidArgument,
                 "brick: owned box " + toString(owned) + " must lie in stored box " +
                     toString(stored) + " inside the grid " + toString(grid.allNodes()));
-  data_.resize(std::size_t(stored.nodeCount()) * scalarSize(type));
+  data_.resize(std::size_t(stored.nodeCount()) * scalarSize(type) + kPaddingBytes);
 }
 
 double Brick::valueAt(IVec3 node) const {

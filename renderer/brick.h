@@ -37,7 +37,10 @@ class Brick {
 
   std::byte* bytes() { return data_.data(); }
   const std::byte* bytes() const { return data_.data(); }
-  std::size_t byteSize() const { return data_.size(); }
+  std::size_t byteSize() const { return data_.size() - kPaddingBytes; }
+  // Storage ends with this many zero bytes, so the vector kernel may load a
+  // 32-bit word at the last voxel of any scalar type.
+  static constexpr std::size_t kPaddingBytes = 8;
   template <typename T> T* as() { return reinterpret_cast<T*>(data_.data()); }
   template <typename T> const T* as() const { return reinterpret_cast<const T*>(data_.data()); }
 

@@ -27,10 +27,10 @@ MacrocellGrid::MacrocellGrid(const Brick& brick) {
     // Each stored node widens every macrocell whose dilated node range
     // [kSize*m - 1, kSize*m + kSize + 1] holds it: at most two per axis.
     auto cellsOf = [&](int a, std::int64_t node, std::int64_t& m0, std::int64_t& m1) {
-      // m0 = ceil((node - kSize - 1) / kSize), m1 = floor((node + 1) / kSize);
+      // m0 = ceil((node - kSize) / kSize), m1 = floor(node / kSize);
       // >> floors negative numbers too.
-      m0 = std::max<std::int64_t>(first_[a], (node - 2) >> kShift);
-      m1 = std::min<std::int64_t>(first_[a] + count_[a] - 1, (node + 1) >> kShift);
+      m0 = std::max<std::int64_t>(first_[a], (node - 1) >> kShift);
+      m1 = std::min<std::int64_t>(first_[a] + count_[a] - 1, node >> kShift);
     };
     for (std::int64_t z = st.lo.z; z <= st.hi.z; ++z) {
       std::int64_t mz0, mz1;

@@ -3,9 +3,12 @@
 // The grid's cells are grouped into macrocells of kSize^3 cells, aligned to
 // the global grid (macrocell m covers cells [kSize*m, kSize*m + kSize)), so
 // a brick and the whole volume skip the same space. Each macrocell keeps the
-// finite min and max of the nodes its samples can read, widened by one node
-// on every side: a sample that rounding places in a neighbouring macrocell
-// still lies inside that neighbour's range. Classification against a
+// finite min and max of the nodes its cells interpolate (kSize + 1 per
+// axis). A sample that rounding places in a neighbouring macrocell lies
+// within ~1e-5 voxel of the shared face, where the reconstruction is the
+// face nodes' values that both macrocells hold. Small macrocells (4^3
+// cells) keep thin visible structures from dragging whole blocks of empty
+// space into the sample loop. Classification against a
 // transfer function is one O(1) query per macrocell, cheap enough to redo on
 // every transfer-function change.
 #pragma once
@@ -20,7 +23,7 @@ namespace pvr::core {
 
 class MacrocellGrid {
  public:
-  static constexpr int kShift = 3;
+  static constexpr int kShift = 2;
   static constexpr int kSize = 1 << kShift;  // cells per macrocell edge
 
   MacrocellGrid() = default;

@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "../error.h"
-#include "kernel.h"
+#include "cast_ray.h"
 
 namespace pvr::core {
 
