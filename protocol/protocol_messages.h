@@ -1,0 +1,291 @@
+// Every PVR message: one struct per type, and the Message variant that is
+// the protocol's table of messages.
+//
+// A message struct carries
+//   - kWire: its wire type number, its name and the Limits field that bounds
+//     its payload;
+//   - fields(self): its payload fields in wire order (field_codec.h says how
+//     each field type is encoded);
+//   - optionally check(limits): rules between fields that decoding enforces.
+// Adding a message is one struct here plus one line in `Message` below; the
+// look-up table (message_table.h), the codec and the dispatcher follow.
+// docs/protocol.md documents every payload byte by byte.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <tuple>
+#include <variant>
+#include <vector>
+
+#include "frame_header.h"
+#include "protocol_error.h"
+
+namespace pvr::proto {
+
+// What the message table knows of a type besides its fields.
+struct WireInfo {
+  std::uint8_t type;                    // header byte 5; never 0
+  std::string_view name;                // "ImageFrame"
+  std::uint32_t Limits::*maxPayload;    // the limit that bounds its payload
+};
+
+// ---- Enumerations carried in payloads (u8 on the wire) ----
+
+enum class ClusterRole : std::uint8_t { kRender = 0, kComposite = 1, kCollector = 2 };
+enum class PixelFormat : std::uint8_t { kRgb8 = 0, kRgba8 = 1 };
+enum class Compression : std::uint8_t { kNone = 0, kRle = 1, kZlib = 2 };
+enum class PerformanceQuery : std::uint8_t { kMemory = 0, kCompositing = 1 };
+
+constexpr bool isWireValue(ClusterRole v) { return v <= ClusterRole::kCollector; }
+constexpr bool isWireValue(PixelFormat v) { return v <= PixelFormat::kRgba8; }
+constexpr bool isWireValue(Compression v) { return v <= Compression::kZlib; }
+constexpr bool isWireValue(PerformanceQuery v) { return v <= PerformanceQuery::kCompositing; }
+// Error codes pass through unchecked: a peer may know codes this build does not.
+constexpr bool isWireValue(ErrorCode) { return true; }
+
+constexpr std::uint32_t channelCount(PixelFormat format) { return format == PixelFormat::kRgba8 ? 4 : 3; }
+
+// ---- Records used inside payloads ----
+
+// One cluster of the session layout (paper 003, Table 1: set -cluster/-group).
+struct ClusterSpec {
+  ClusterRole role = ClusterRole::kRender;
+  std::uint32_t ranks = 0;  // 0: the master sizes the cluster
+  std::uint32_t group = 0;  // clusters of one group share the scanlines of one frame
+  static auto fields(auto& self) { return std::tie(self.role, self.ranks, self.group); }
+  bool operator==(const ClusterSpec&) const = default;
+};
+
+// Where the time of one frame went, in seconds, as measured on the ranks.
+struct FrameTiming {
+  double distribute = 0;   // sending view and bricks to the rendering clusters
+  double render = 0;       // ray casting
+  double composite = 0;    // compositing
+  double communicate = 0;  // waiting on other ranks
+  double send = 0;         // collector: conversion, compression and send
+  static auto fields(auto& self) {
+    return std::tie(self.distribute, self.render, self.composite, self.communicate, self.send);
+  }
+  bool operator==(const FrameTiming&) const = default;
+};
+
+struct KeyValue {
+  std::string key;
+  std::string value;
+  static auto fields(auto& self) { return std::tie(self.key, self.value); }
+  bool operator==(const KeyValue&) const = default;
+};
+
+inline constexpr std::size_t kNonceBytes = 32;  // AuthChallenge nonce
+inline constexpr std::size_t kMacBytes = 32;    // HMAC-SHA256 output
+
+// ---- Connection: hello, authentication, acknowledgement, error, close ----
+
+// Client -> server, first message of a connection.
+struct Hello {
+  static constexpr WireInfo kWire{0x01, "Hello", &Limits::maxControlPayload};
+  std::string software;  // "pvrsh 0.1"
+  static auto fields(auto& self) { return std::tie(self.software); }
+  bool operator==(const Hello&) const = default;
+};
+
+// Server -> client, answers Hello.
+struct Welcome {
+  static constexpr WireInfo kWire{0x02, "Welcome", &Limits::maxControlPayload};
+  std::string software;       // "pvrd 0.1"
+  std::uint32_t maxRanks = 0; // the most ranks a session may ask for
+  bool authRequired = false;  // an AuthChallenge follows
+  static auto fields(auto& self) { return std::tie(self.software, self.maxRanks, self.authRequired); }
+  bool operator==(const Welcome&) const = default;
+};
+
+// Server -> client: prove knowledge of the shared token.
+struct AuthChallenge {
+  static constexpr WireInfo kWire{0x03, "AuthChallenge", &Limits::maxControlPayload};
+  std::array<std::uint8_t, kNonceBytes> nonce{};  // fresh random bytes
+  static auto fields(auto& self) { return std::tie(self.nonce); }
+  bool operator==(const AuthChallenge&) const = default;
+};
+
+// Client -> server: HMAC-SHA256(token, nonce). The protocol carries bytes only.
+struct AuthResponse {
+  static constexpr WireInfo kWire{0x04, "AuthResponse", &Limits::maxControlPayload};
+  std::array<std::uint8_t, kMacBytes> mac{};
+  static auto fields(auto& self) { return std::tie(self.mac); }
+  bool operator==(const AuthResponse&) const = default;
+};
+
+// Either direction: the request with this id succeeded.
+struct Ok {
+  static constexpr WireInfo kWire{0x05, "Ok", &Limits::maxControlPayload};
+  static auto fields(auto&) { return std::tie(); }
+  bool operator==(const Ok&) const = default;
+};
+
+// Either direction: the request with this id failed (id 0: the connection did).
+struct ErrorMessage {
+  static constexpr WireInfo kWire{0x06, "Error", &Limits::maxControlPayload};
+  ErrorCode code = ErrorCode::kInternal;
+  std::string text;
+  static auto fields(auto& self) { return std::tie(self.code, self.text); }
+  bool operator==(const ErrorMessage&) const = default;
+};
+
+// Either direction: the sender closes the connection after this frame.
+struct Close {
+  static constexpr WireInfo kWire{0x07, "Close", &Limits::maxControlPayload};
+  std::string reason;
+  static auto fields(auto& self) { return std::tie(self.reason); }
+  bool operator==(const Close&) const = default;
+};
+
+// ---- Session and scene ----
+
+// Client -> server: start the MPI job.
+struct SessionOpen {
+  static constexpr WireInfo kWire{0x10, "SessionOpen", &Limits::maxControlPayload};
+  std::uint32_t rankCount = 0;        // 0: the daemon's default
+  std::vector<ClusterSpec> clusters;  // empty: the master's default layout
+  static auto fields(auto& self) { return std::tie(self.rankCount, self.clusters); }
+  bool operator==(const SessionOpen&) const = default;
+};
+
+// Server -> client, answers SessionOpen and SetLayout: the layout in force.
+struct SessionReady {
+  static constexpr WireInfo kWire{0x11, "SessionReady", &Limits::maxControlPayload};
+  std::uint32_t rankCount = 0;
+  std::vector<ClusterSpec> clusters;
+  static auto fields(auto& self) { return std::tie(self.rankCount, self.clusters); }
+  bool operator==(const SessionReady&) const = default;
+};
+
+// Client -> server: change the dataset and/or any scene parameter.
+struct SetScene {
+  static constexpr WireInfo kWire{0x12, "SetScene", &Limits::maxTextPayload};
+  std::string dataset;    // a catalog name; empty: unchanged
+  std::string sceneJson;  // a partial scene document merged into the scene; empty: unchanged
+  static auto fields(auto& self) { return std::tie(self.dataset, self.sceneJson); }
+  bool operator==(const SetScene&) const = default;
+};
+
+// Client -> server: re-arrange the clusters of an open session.
+struct SetLayout {
+  static constexpr WireInfo kWire{0x13, "SetLayout", &Limits::maxControlPayload};
+  std::vector<ClusterSpec> clusters;
+  static auto fields(auto& self) { return std::tie(self.clusters); }
+  bool operator==(const SetLayout&) const = default;
+};
+
+// ---- Rendering ----
+
+// Client -> server: one frame of the current scene (frame number 0).
+struct RenderFrame {
+  static constexpr WireInfo kWire{0x20, "RenderFrame", &Limits::maxControlPayload};
+  static auto fields(auto&) { return std::tie(); }
+  bool operator==(const RenderFrame&) const = default;
+};
+
+// Client -> server: frames k = start..end of a rotation about `axis` through
+// the volume centre, frame k at angle 360 degrees * k / stepsPerTurn
+// ("render rotate 0,1,0 15,59:60" of paper 003 is 45 frames).
+struct RenderRotation {
+  static constexpr WireInfo kWire{0x21, "RenderRotation", &Limits::maxControlPayload};
+  std::array<double, 3> axis{0, 1, 0};
+  std::int32_t start = 0;
+  std::int32_t end = 0;
+  std::uint32_t stepsPerTurn = 1;
+  static auto fields(auto& self) { return std::tie(self.axis, self.start, self.end, self.stepsPerTurn); }
+  bool operator==(const RenderRotation&) const = default;
+};
+
+// Server -> client: one rendered frame.
+struct ImageFrame {
+  static constexpr WireInfo kWire{0x22, "ImageFrame", &Limits::maxFrameBytes};
+  std::uint32_t frameNumber = 0;  // position in its request: 0, 1, 2, ...
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  PixelFormat format = PixelFormat::kRgb8;
+  Compression compression = Compression::kNone;
+  FrameTiming timing;
+  std::vector<std::uint8_t> pixels;  // rows top to bottom, 8-bit sRGB, as compressed
+  static auto fields(auto& self) {
+    return std::tie(self.frameNumber, self.width, self.height, self.format, self.compression, self.timing,
+                    self.pixels);
+  }
+  // width, height >= 1; width * height <= limits.maxImagePixels; uncompressed
+  // pixels are exactly width * height * channels bytes.
+  std::optional<ProtocolError> check(const Limits& limits) const;
+  bool operator==(const ImageFrame&) const = default;
+};
+
+// Client -> server: stop the request `target`; it ends with Error kCancelled.
+struct Cancel {
+  static constexpr WireInfo kWire{0x23, "Cancel", &Limits::maxControlPayload};
+  std::uint32_t target = 0;
+  static auto fields(auto& self) { return std::tie(self.target); }
+  bool operator==(const Cancel&) const = default;
+};
+
+// ---- Queries ----
+
+struct StatusRequest {
+  static constexpr WireInfo kWire{0x30, "StatusRequest", &Limits::maxControlPayload};
+  static auto fields(auto&) { return std::tie(); }
+  bool operator==(const StatusRequest&) const = default;
+};
+
+// Connection state and internal variables ("list status"), in order.
+struct StatusReply {
+  static constexpr WireInfo kWire{0x31, "StatusReply", &Limits::maxTextPayload};
+  std::vector<KeyValue> entries;
+  static auto fields(auto& self) { return std::tie(self.entries); }
+  bool operator==(const StatusReply&) const = default;
+};
+
+inline constexpr std::uint32_t kAllClusters = 0xFFFFFFFFu;
+
+// "performance memory cluster" / "performance comp cluster latency".
+struct PerformanceRequest {
+  static constexpr WireInfo kWire{0x32, "PerformanceRequest", &Limits::maxControlPayload};
+  PerformanceQuery query = PerformanceQuery::kMemory;
+  std::uint32_t cluster = kAllClusters;  // cluster index, or kAllClusters
+  static auto fields(auto& self) { return std::tie(self.query, self.cluster); }
+  bool operator==(const PerformanceRequest&) const = default;
+};
+
+// A JSON document whose keys docs/protocol.md lists per query.
+struct PerformanceReply {
+  static constexpr WireInfo kWire{0x33, "PerformanceReply", &Limits::maxTextPayload};
+  PerformanceQuery query = PerformanceQuery::kMemory;
+  std::string json;
+  static auto fields(auto& self) { return std::tie(self.query, self.json); }
+  bool operator==(const PerformanceReply&) const = default;
+};
+
+struct CatalogRequest {
+  static constexpr WireInfo kWire{0x34, "CatalogRequest", &Limits::maxControlPayload};
+  static auto fields(auto&) { return std::tie(); }
+  bool operator==(const CatalogRequest&) const = default;
+};
+
+// The dataset names the server can open, sorted.
+struct CatalogReply {
+  static constexpr WireInfo kWire{0x35, "CatalogReply", &Limits::maxTextPayload};
+  std::vector<std::string> datasets;
+  static auto fields(auto& self) { return std::tie(self.datasets); }
+  bool operator==(const CatalogReply&) const = default;
+};
+
+// The message table: one line per message type. Order is free (wire type
+// numbers live in kWire); message_table.cpp checks they are unique.
+using Message = std::variant<
+    Hello, Welcome, AuthChallenge, AuthResponse, Ok, ErrorMessage, Close,
+    SessionOpen, SessionReady, SetScene, SetLayout,
+    RenderFrame, RenderRotation, ImageFrame, Cancel,
+    StatusRequest, StatusReply, PerformanceRequest, PerformanceReply, CatalogRequest, CatalogReply>;
+
+}  // namespace pvr::proto
