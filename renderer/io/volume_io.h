@@ -37,6 +37,7 @@ struct VolumeFormat {
   const char* name;
   bool (*matches)(const std::string& path);
   std::unique_ptr<VolumeSource> (*open)(const std::string& path);
+  const char* extensions = "";  // for messages: ".nrrd .nhdr"
 };
 
 // Every registered format, in the order they are tried (volume_formats.cpp).
@@ -56,5 +57,13 @@ std::unique_ptr<VolumeSource> openVolumeFile(const std::string& path);
 std::unique_ptr<VolumeSource> openProcedural(const std::string& name, IVec3 dims);
 std::unique_ptr<VolumeSource> openProcedural(const std::string& name, IVec3 dims, Vec3 spacing);
 std::vector<std::string> proceduralNames();
+
+// The analytic field a procedural volume samples, at a world position (the
+// grid puts node (i,j,k) at origin + (i,j,k) * spacing). Reference
+// integrators use it; note that the renderer sees the trilinear
+// reconstruction of the grid samples, which differs from this field between
+// nodes (and across the Shepp-Logan phantom's sharp edges). Throws pvr::Error
+// for an unknown name.
+double proceduralValue(const std::string& name, Vec3 position);
 
 }  // namespace pvr::core

@@ -1,0 +1,44 @@
+// Byte streams the raw box reader pulls voxel runs from.
+//
+// The reader asks for runs in increasing offset order, so one interface
+// serves both a file read in place (pread at any offset: a brick costs I/O
+// proportional to its size) and a compressed stream that can only go forward
+// (it decodes and discards what lies between runs).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace pvr::core {
+
+class ByteStream {
+ public:
+  virtual ~ByteStream() = default;
+  // Copies bytes [offset, offset + n) of the (decoded) stream into dst.
+  // Offsets never decrease from one call to the next. Throws pvr::Error
+  // naming the file when the bytes are not there.
+  virtual void read(std::uint64_t offset, std::byte* dst, std::size_t n) = 0;
+};
+
+// A file opened read-only for positioned reads; closes it on destruction.
+class FileStream final : public ByteStream {
+ public:
+  // Error messages start with `path`.
+  explicit FileStream(const std::string& path);
+  ~FileStream() override;
+  FileStream(const FileStream&) = delete;
+  FileStream& operator=(const FileStream&) = delete;
+
+  // Reads exactly n bytes at offset; throws if the file ends first.
+  void read(std::uint64_t offset, std::byte* dst, std::size_t n) override;
+  // Reads up to n bytes at offset; returns how many (fewer only at the end of the file).
+  std::size_t readSome(std::uint64_t offset, std::byte* dst, std::size_t n);
+  const std::string& where() const { return where_; }
+
+ private:
+  int fd_ = -1;
+  std::string where_;
+};
+
+}  // namespace pvr::core

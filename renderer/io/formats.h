@@ -1,0 +1,24 @@
+// The file formats volume_formats.cpp registers: one matches/open pair per
+// format file. Internal to renderer/io; callers use openVolumeFile.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "volume_io.h"
+
+namespace pvr::core {
+
+// raw_json.cpp: a raw voxel file plus its JSON sidecar (dims, dtype, spacing, ...).
+bool isRawJsonPath(const std::string& path);
+std::unique_ptr<VolumeSource> openRawJson(const std::string& path);
+
+// nrrd.cpp: NRRD with an attached (.nrrd) or detached (.nhdr) header.
+bool isNrrdPath(const std::string& path);
+std::unique_ptr<VolumeSource> openNrrd(const std::string& path);
+
+// nifti.cpp: NIfTI-1 single files (.nii, .nii.gz).
+bool isNiftiPath(const std::string& path);
+std::unique_ptr<VolumeSource> openNifti(const std::string& path);
+
+}  // namespace pvr::core

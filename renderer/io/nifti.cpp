@@ -1,0 +1,158 @@
+// NIfTI-1 single-file volumes (.nii, .nii.gz) through nifti_clib.
+//
+// nifti_clib converts the header (byte order, dim, pixdim, qform/sform,
+// vox_offset); the voxels then go through the shared raw/gzip box reader, so
+// an uncompressed .nii reads a brick in place at vox_offset and a .nii.gz
+// decodes forward and keeps only the box. We look at the first 348 bytes
+// ourselves before calling nifti_clib, because it reports a bad file by
+// printing to stderr and returning NULL, which would leave our message
+// unable to say what is wrong.
+//
+// The grid is axis-aligned: spacing is |pixdim|, the origin the qform
+// offset (else the sform translation, else 0); rotations and flips are not
+// applied. A scl_slope other than 0 or 1 (or a nonzero scl_inter) makes the
+// volume float32 with the scaling applied, since the stored integers are
+// not the values the file means.
+#include <nifti/nifti1_io.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "byte_stream.h"
+#include "formats.h"
+#include "gzip_stream.h"
+#include "raw_reader.h"
+#include "source_util.h"
+
+namespace pvr::core {
+
+namespace {
+
+constexpr std::size_t kNifti1HeaderBytes = 348;
+// nifti_image::byteorder of big-endian data (nifti1_io.h defines MSB_FIRST
+// only for nifti1_io.c itself).
+constexpr int kNiftiMsbFirst = 2;
+
+// Step 1: sizeof_hdr and the magic, read from the (decoded) file start.
+void checkNifti1Header(const std::string& path, bool gzip) {
+  unsigned char raw[kNifti1HeaderBytes];
+  auto* bytes = reinterpret_cast<std::byte*>(raw);
+  if (gzip) {
+    GzipStream(path, 0).read(0, bytes, sizeof raw);
+  } else {
+    const std::uint64_t size = fileSizeOf(path);
+    if (size < sizeof raw)
+      failAt(ErrorCode::kBadFile, path,
+             "file has " + std::to_string(size) + " bytes, a NIfTI-1 header needs 348");
+    FileStream(path).read(0, bytes, sizeof raw);
+  }
+  std::int32_t sizeofHdr;
+  std::memcpy(&sizeofHdr, raw, 4);
+  const std::int32_t swapped = std::int32_t(__builtin_bswap32(std::uint32_t(sizeofHdr)));
+  if (sizeofHdr == 540 || swapped == 540)
+    failAt(ErrorCode::kUnsupported, path, "NIfTI-2 files are not supported, only NIfTI-1");
+  if (sizeofHdr != 348 && swapped != 348)
+    failAt(ErrorCode::kBadFile, path,
+           "not a NIfTI-1 file: header size field is " + std::to_string(sizeofHdr) + ", expected 348");
+  const char* magic = reinterpret_cast<const char*>(raw + 344);
+  if (std::memcmp(magic, "ni1", 4) == 0)
+    failAt(ErrorCode::kUnsupported, path, "a .hdr/.img pair header; only single-file .nii is supported");
+  if (std::memcmp(magic, "n+1", 4) != 0)
+    failAt(ErrorCode::kBadFile, path,
+           "no NIfTI-1 magic 'n+1' (found " + quoteForMessage(std::string_view(magic, 4)) + ")");
+}
+
+ScalarType niftiScalarType(const nifti_image& nim, const std::string& path) {
+  switch (nim.datatype) {
+    case DT_UINT8: return ScalarType::kUInt8;
+    case DT_UINT16: return ScalarType::kUInt16;
+    case DT_INT16: return ScalarType::kInt16;
+    case DT_FLOAT32: return ScalarType::kFloat32;
+    default: break;
+  }
+  failAt(ErrorCode::kUnsupported, path,
+         std::string("datatype ") + nifti_datatype_string(nim.datatype) +
+             " is not supported (UINT8, UINT16, INT16, FLOAT32)");
+}
+
+GridGeometry niftiGrid(const nifti_image& nim, const std::string& path) {
+  for (int d = 4; d <= 7; ++d)
+    if (nim.dim[d] > 1)
+      failAt(ErrorCode::kUnsupported, path,
+             "dimension " + std::to_string(d) + " has " + std::to_string(nim.dim[d]) +
+                 " entries; only 3D volumes are supported");
+  GridGeometry grid;
+  grid.dims = {std::max(nim.nx, 1), std::max(nim.ny, 1), std::max(nim.nz, 1)};
+  grid.spacing = {std::fabs(nim.dx), std::fabs(nim.dy), std::fabs(nim.dz)};
+  if (nim.qform_code > 0)
+    grid.origin = {nim.qoffset_x, nim.qoffset_y, nim.qoffset_z};
+  else if (nim.sform_code > 0)
+    grid.origin = {nim.sto_xyz.m[0][3], nim.sto_xyz.m[1][3], nim.sto_xyz.m[2][3]};
+  return grid;
+}
+
+// Applies value = slope * stored + inter, turning the volume into float32.
+class ScaledSource final : public VolumeSource {
+ public:
+  ScaledSource(std::unique_ptr<VolumeSource> stored, double slope, double inter)
+      : stored_(std::move(stored)), slope_(slope), inter_(inter) {}
+
+  const GridGeometry& grid() const override { return stored_->grid(); }
+  ScalarType type() const override { return ScalarType::kFloat32; }
+  bool canReadPartially() const override { return stored_->canReadPartially(); }
+  Brick readBox(const NodeBox& owned, const NodeBox& stored) const override {
+    const Brick in = stored_->readBox(owned, stored);
+    Brick out(in.grid(), ScalarType::kFloat32, owned, stored);
+    float* v = out.as<float>();
+    dispatchScalar(in.type(), [&](auto tag) {
+      using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+      const T* s = in.as<T>();
+      for (std::size_t i = 0, n = std::size_t(stored.nodeCount()); i < n; ++i)
+        v[i] = float(slope_ * double(s[i]) + inter_);
+    });
+    out.updateValueRange();
+    return out;
+  }
+  std::string describe() const override {
+    return stored_->describe() + " scaled to float32 (" + std::to_string(slope_) + " * v + " +
+           std::to_string(inter_) + ")";
+  }
+
+ private:
+  std::unique_ptr<VolumeSource> stored_;
+  double slope_, inter_;
+};
+
+}  // namespace
+
+bool isNiftiPath(const std::string& path) {
+  return pathEndsWith(path, ".nii") || pathEndsWith(path, ".nii.gz");
+}
+
+std::unique_ptr<VolumeSource> openNifti(const std::string& path) {
+  const bool gzip = pathEndsWith(path, ".gz");
+  checkNifti1Header(path, gzip);
+
+  // Step 2: nifti_clib converts the header; the voxels are left to us.
+  const std::unique_ptr<nifti_image, void (*)(nifti_image*)> nim(nifti_image_read(path.c_str(), 0),
+                                                                 &nifti_image_free);
+  if (!nim) failAt(ErrorCode::kBadFile, path, "nifti_clib cannot read the NIfTI-1 header");
+  const ScalarType type = niftiScalarType(*nim, path);
+  const GridGeometry grid = niftiGrid(*nim, path);
+
+  // Step 3: the voxels start at vox_offset, in the file or in the gzip stream.
+  RawLayout layout;
+  layout.dataPath = path;
+  layout.encoding = gzip ? RawEncoding::kGzip : RawEncoding::kRaw;
+  layout.offset = std::uint64_t(std::max(nim->iname_offset, 0));
+  layout.bigEndian = nim->byteorder == kNiftiMsbFirst;
+  auto source = openRawVolume(fileNameOf(path), grid, type, std::move(layout), SizeRule::kAtLeast);
+
+  const double slope = nim->scl_slope, inter = nim->scl_inter;
+  if (std::isfinite(slope) && std::isfinite(inter) && slope != 0 && (slope != 1 || inter != 0))
+    return std::make_unique<ScaledSource>(std::move(source), slope, inter);
+  return source;
+}
+
+}  // namespace pvr::core

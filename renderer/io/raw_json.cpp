@@ -1,0 +1,134 @@
+// Raw voxels plus a JSON sidecar, the form of ../shared/data/<name>/<name>.json:
+//   {"dims": [nx, ny, nz], "dtype": "int16", "spacing": [sx, sy, sz],
+//    "origin": [ox, oy, oz]            (optional, default 0),
+//    "raw_file": "<name>.raw"          (optional, default: the .raw beside the sidecar),
+//    "endian": "little" | "big"        (optional, default little), ...}
+// Other keys (provenance, licence, statistics) are ignored. Either file may
+// be given: a .raw finds its sidecar beside it, <stem>.json.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "formats.h"
+#include "raw_reader.h"
+#include "source_util.h"
+
+namespace pvr::core {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// A sidecar is a few kilobytes; refuse to slurp a multi-megabyte file named .json.
+constexpr std::uint64_t kMaxSidecarBytes = std::uint64_t(1) << 24;
+
+json readSidecar(const std::string& path) {
+  const std::uint64_t size = fileSizeOf(path);
+  if (size > kMaxSidecarBytes)
+    failAt(ErrorCode::kBadFile, path,
+           "sidecar has " + std::to_string(size) + " bytes, more than a volume description needs");
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in) failAt(ErrorCode::kIo, path, "cannot read the sidecar");
+  try {
+    json doc = json::parse(text.str());
+    if (!doc.is_object()) failAt(ErrorCode::kBadFile, path, "sidecar is not a JSON object");
+    return doc;
+  } catch (const json::parse_error& e) {
+    failAt(ErrorCode::kBadFile, path, std::string("sidecar is not valid JSON: ") + e.what());
+  }
+}
+
+const json& member(const json& doc, const char* key, const std::string& path) {
+  const auto it = doc.find(key);
+  if (it == doc.end()) failAt(ErrorCode::kBadFile, path, std::string("sidecar has no '") + key + "' key");
+  return *it;
+}
+
+bool isTriple(const json& v) { return v.is_array() && v.size() == 3; }
+
+IVec3 readDims(const json& doc, const std::string& path) {
+  const json& v = member(doc, "dims", path);
+  IVec3 dims;
+  if (isTriple(v))
+    for (int a = 0; a < 3; ++a)
+      if (v[a].is_number_integer() && v[a].get<std::int64_t>() >= 1) dims[a] = v[a].get<std::int64_t>();
+  if (dims.x < 1 || dims.y < 1 || dims.z < 1)
+    failAt(ErrorCode::kBadFile, path, "'dims' must be 3 positive integers, got " + v.dump());
+  return dims;
+}
+
+Vec3 readTriple(const json& v, const char* key, const std::string& path) {
+  Vec3 out;
+  bool ok = isTriple(v);
+  for (int a = 0; ok && a < 3; ++a) {
+    ok = v[a].is_number();
+    if (ok) out[a] = v[a].get<double>();
+  }
+  if (!ok) failAt(ErrorCode::kBadFile, path, std::string("'") + key + "' must be 3 numbers, got " + v.dump());
+  return out;
+}
+
+std::string readString(const json& v, const char* key, const std::string& path) {
+  if (!v.is_string())
+    failAt(ErrorCode::kBadFile, path, std::string("'") + key + "' must be a string, got " + v.dump());
+  return v.get<std::string>();
+}
+
+bool readBigEndian(const json& doc, const std::string& path) {
+  const auto it = doc.find("endian");
+  if (it == doc.end()) return false;
+  const std::string endian = readString(*it, "endian", path);
+  if (endian != "little" && endian != "big")
+    failAt(ErrorCode::kBadFile, path, "'endian' must be \"little\" or \"big\", got \"" + endian + "\"");
+  return endian == "big";
+}
+
+// The raw file the sidecar describes. Given a .raw, it must be that file.
+std::string rawPathFor(const json& doc, const std::string& jsonPath, const std::string& givenRaw) {
+  const auto it = doc.find("raw_file");
+  if (it == doc.end())
+    return givenRaw.empty() ? fs::path(jsonPath).replace_extension(".raw").string() : givenRaw;
+  const fs::path named = fs::path(jsonPath).parent_path() / readString(*it, "raw_file", jsonPath);
+  if (!givenRaw.empty()) {
+    std::error_code ec;
+    if (!fs::equivalent(named, givenRaw, ec))
+      failAt(ErrorCode::kBadFile, givenRaw,
+             "sidecar " + jsonPath + " describes '" + named.string() + "', not this file");
+  }
+  return named.string();
+}
+
+}  // namespace
+
+bool isRawJsonPath(const std::string& path) {
+  return pathEndsWith(path, ".json") || pathEndsWith(path, ".raw");
+}
+
+std::unique_ptr<VolumeSource> openRawJson(const std::string& path) {
+  // Step: find the sidecar (the path itself, or <stem>.json beside a .raw).
+  const bool givenRaw = pathEndsWith(path, ".raw");
+  const std::string jsonPath = givenRaw ? fs::path(path).replace_extension(".json").string() : path;
+  if (givenRaw && !fs::exists(jsonPath))
+    failAt(ErrorCode::kIo, path, "no JSON sidecar " + jsonPath + " beside it (dims, dtype, spacing)");
+  const json doc = readSidecar(jsonPath);
+
+  // Step: the grid, type and byte order it states.
+  GridGeometry grid;
+  grid.dims = readDims(doc, jsonPath);
+  grid.spacing = readTriple(member(doc, "spacing", jsonPath), "spacing", jsonPath);
+  if (const auto it = doc.find("origin"); it != doc.end()) grid.origin = readTriple(*it, "origin", jsonPath);
+  const ScalarType type = parseScalarType(readString(member(doc, "dtype", jsonPath), "dtype", jsonPath), jsonPath);
+
+  RawLayout layout;
+  layout.dataPath = rawPathFor(doc, jsonPath, givenRaw ? path : std::string());
+  layout.headerPath = jsonPath;
+  layout.bigEndian = readBigEndian(doc, jsonPath);
+  return openRawVolume(fileNameOf(path), grid, type, std::move(layout), SizeRule::kExact);
+}
+
+}  // namespace pvr::core
