@@ -39,11 +39,18 @@ class KdTree {
   // Splits into `ranks` leaves; a node with n ranks gives floor(n/2) to the
   // left and ceil(n/2) to the right, and places the plane so each side's
   // cell count is proportional to its rank count. Every leaf keeps at least
-  // one cell on every axis the grid has cells on. Throws if the grid has
-  // fewer cells than ranks along every possible split.
+  // one cell on every axis the grid has cells on; where the proportional
+  // plane would starve a side of the cells its ranks need, the plane moves
+  // just far enough. Axes: kAlternating takes x, y, z, x, ... (each child
+  // starts after its parent's axis) and skips an axis no plane can split;
+  // kLongest takes the longest splittable axis in world units (spacing
+  // counts; ties go to the lower axis). Throws pvr::Error if ranks < 1 or
+  // no such tree exists (e.g. more ranks than cells).
   static KdTree build(const GridGeometry& grid, int ranks, SplitAxisRule rule);
-  // As build, but planes split the non-empty content (ContentGrid) in
-  // proportion to the ranks instead of the cells.
+  // As build, but planes split the non-empty content (ContentGrid, see
+  // content.h; a block's count is taken as spread evenly over its cells) in
+  // proportion to the ranks instead of the cells. A region without content
+  // splits by cells. Throws if `content` does not fit the grid.
   static KdTree buildBalanced(const GridGeometry& grid, int ranks, SplitAxisRule rule,
                               const ContentGrid& content);
 
@@ -59,14 +66,27 @@ class KdTree {
   bool leftInFront(int node, const Camera& camera) const;
   // Ranks front to back for this camera.
   std::vector<int> visibilityOrder(const Camera& camera) const;
+  // True when rankA's brick comes before rankB's in visibilityOrder: the
+  // split that separates them (their lowest common ancestor) puts rankA on
+  // the viewer's side. O(depth); for strategies that pair ranks freely.
+  bool inFront(int rankA, int rankB, const Camera& camera) const;
 
   const GridGeometry& grid() const { return grid_; }
 
  private:
+  // build and buildBalanced; `content` is null for the plain split.
+  static KdTree make(const GridGeometry& grid, int ranks, SplitAxisRule rule,
+                     const ContentGrid* content);
+
   GridGeometry grid_;
   int ranks_ = 0;
   std::vector<KdNode> nodes_;
   std::vector<int> leafOfRank_;
 };
+
+// The box `rank` stores: its owned box grown by `ghost` layers (from
+// ghostLayers() of the render options), clipped to the grid; the stored box
+// of cropBrick(source, tree.ownedBox(rank), ghost).
+NodeBox storedBox(const KdTree& tree, int rank, int ghost);
 
 }  // namespace pvr::core
