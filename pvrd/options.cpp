@@ -1,0 +1,78 @@
+#include "options.h"
+
+#include <charconv>
+
+namespace pvr::daemon {
+namespace {
+
+bool toInt(const std::string& text, int lo, int hi, int& out) {
+  int v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || v < lo || v > hi) return false;
+  out = v;
+  return true;
+}
+
+}  // namespace
+
+bool isLoopback(const std::string& host) {
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
+
+std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, std::string& error) {
+  DaemonOptions o;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (i + 1 >= args.size()) {
+      error = a.rfind("--", 0) == 0 ? a + " needs a value" : "unexpected argument '" + a + "'";
+      return std::nullopt;
+    }
+    const std::string& v = args[++i];
+    if (a == "--listen") {
+      const auto colon = v.rfind(':');
+      if (colon == std::string::npos || colon == 0 || !toInt(v.substr(colon + 1), 0, 65535, o.port)) {
+        error = "--listen takes HOST:PORT, not '" + v + "'";
+        return std::nullopt;
+      }
+      o.host = v.substr(0, colon);
+      if (o.host.size() > 2 && o.host.front() == '[' && o.host.back() == ']') o.host = o.host.substr(1, o.host.size() - 2);
+    } else if (a == "--data-dir") {
+      o.dataDir = v;
+    } else if (a == "--hostfile") {
+      o.hostfile = v;
+    } else if (a == "--max-ranks" || a == "--max-sessions") {
+      int& target = a == "--max-ranks" ? o.maxRanks : o.maxSessions;
+      if (!toInt(v, 1, 4096, target)) {
+        error = a + " takes an integer in [1, 4096], not '" + v + "'";
+        return std::nullopt;
+      }
+    } else if (a == "--token-file") {
+      o.tokenFile = v;
+    } else if (a == "--mpirun") {
+      o.mpirun = v;
+    } else if (a == "--node") {
+      o.node = v;
+    } else if (a == "--idle-timeout") {
+      int s = 0;
+      if (!toInt(v, 1, 1 << 30, s)) {
+        error = "--idle-timeout takes a positive number of seconds, not '" + v + "'";
+        return std::nullopt;
+      }
+      o.idleTimeout = s;
+    } else {
+      error = "unknown option '" + a + "'";
+      return std::nullopt;
+    }
+  }
+  if (o.dataDir.empty()) {
+    error = "--data-dir is required";
+    return std::nullopt;
+  }
+  if (!isLoopback(o.host) && o.tokenFile.empty()) {
+    error = "refusing to listen on " + o.host + " without --token-file (see docs/pvrd.md)";
+    return std::nullopt;
+  }
+  return o;
+}
+
+}  // namespace pvr::daemon

@@ -1,0 +1,30 @@
+// pvrd's command line: parsed into plain data, checked, no side effects.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pvr::daemon {
+
+struct DaemonOptions {
+  std::string host = "127.0.0.1";
+  int port = 0;                 // 0: an ephemeral port
+  std::string dataDir;
+  std::string hostfile;         // passed to mpirun when set
+  int maxRanks = 4;
+  int maxSessions = 4;
+  std::string tokenFile;        // shared secret; required for a non-loopback address
+  std::string mpirun = "mpirun";
+  std::string node;             // pvr-node executable; empty: next to pvrd
+  double idleTimeout = 600;     // seconds without a client frame
+  double frameTimeout = 10;     // seconds to finish a frame once started
+};
+
+// Parses argv[1..]; on a bad command line returns nullopt and sets `error`.
+std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, std::string& error);
+
+// True for 127.0.0.0/8, ::1 and "localhost".
+bool isLoopback(const std::string& host);
+
+}  // namespace pvr::daemon

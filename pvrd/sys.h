@@ -1,0 +1,37 @@
+// Thin syscall wrappers: each returns the descriptor or -1 and fills `error`
+// with the call and errno text; on failure they close what they opened.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+
+namespace pvr::daemon {
+
+// A TCP socket bound to host:port and listening. `port` 0 picks one; the
+// bound port is stored back into it.
+int tcpListen(const std::string& host, int& port, std::string& error);
+// Connects to host:port (blocking).
+int tcpConnect(const std::string& host, int port, std::string& error);
+// accept() with CLOEXEC; -1 and error text on failure.
+int tcpAccept(int listenFd, std::string& error);
+
+// Writes all bytes; false (with error text) on failure or when the peer stops
+// reading for longer than the socket's send timeout.
+bool writeAll(int fd, std::span<const std::uint8_t> bytes, std::string& error);
+// Sets SO_SNDTIMEO so a stalled reader cannot block a writer for ever.
+void setSendTimeout(int fd, double seconds);
+
+// errno as "call: text".
+std::string errnoText(const char* call);
+
+// Seconds on the monotonic clock.
+double monotonicSeconds();
+
+// One log record on stderr: "<ISO time> session <id>: <event>" (id 0: the daemon).
+void logEvent(std::uint64_t session, const std::string& event);
+
+// `bytes` with non-printable characters masked, at most `max` of them.
+std::string printable(std::span<const std::uint8_t> bytes, std::size_t max = 32);
+
+}  // namespace pvr::daemon
