@@ -1,8 +1,7 @@
 // Sparse image codecs: lossless, small where images are sparse, and
 // hostile bytes throw pvr::Error instead of crashing or allocating.
-#include "image_codec.h"
-
 #include <catch2/catch.hpp>
+
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -10,6 +9,7 @@
 #include <vector>
 
 #include "error.h"
+#include "image_codec.h"
 
 namespace pvr::core {
 namespace {

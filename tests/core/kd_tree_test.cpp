@@ -3,19 +3,18 @@
 // counts (or the content), the traversal order is a correct front-to-back
 // order for any camera, and bricks cut by the tree render, composited in
 // that order, to the image of the whole.
-#include "decompose/kd_tree.h"
+#include <catch2/catch.hpp>
 
 #include <algorithm>
-#include <catch2/catch.hpp>
 #include <cmath>
 #include <memory>
 #include <random>
 #include <vector>
 
 #include "decompose/content.h"
+#include "decompose/kd_tree.h"
 #include "error.h"
 #include "raycast/raycaster.h"
-#include "reference.h"
 
 namespace pvr::core {
 namespace {
@@ -41,6 +40,19 @@ Camera viewFrom(Projection projection, Vec3 eye, Vec3 at, double orthoHeight, in
   s.fovYDeg = 50;
   s.automatic = false;
   return Camera(s, size, size);
+}
+
+// A whole-volume float32 brick with node values f(world position).
+template <typename F>
+Brick floatVolume(const GridGeometry& grid, F f) {
+  Brick volume(grid, ScalarType::kFloat32, grid.allNodes(), grid.allNodes());
+  float* v = volume.as<float>();
+  for (std::int64_t z = 0; z < grid.dims.z; ++z)
+    for (std::int64_t y = 0; y < grid.dims.y; ++y)
+      for (std::int64_t x = 0; x < grid.dims.x; ++x)
+        v[volume.linearIndex({x, y, z})] = float(f(grid.nodePosition({x, y, z})));
+  volume.updateValueRange();
+  return volume;
 }
 
 Vec3 randomDirection(std::mt19937& rng) {
@@ -112,7 +124,7 @@ std::vector<std::uint64_t> contentPerRank(const KdTree& tree, const Brick& whole
 // transfer function that shows only values above 0.5.
 struct CornerScene {
   GridGeometry grid = makeGrid({40, 40, 40});
-  Brick volume = makeVolume(grid, ScalarType::kFloat32, [](Vec3 p) {
+  Brick volume = floatVolume(grid, [](Vec3 p) {
     return length(p - Vec3{9, 10, 8}) < 15 ? 1.0 : 0.0;
   });
   TransferTable table;
@@ -453,7 +465,7 @@ TEST_CASE("visibilityOrder is a front-to-back order for any camera", "[kd]") {
 
 TEST_CASE("storedBox holds the ghost layers ghostLayers asks for and no more", "[kd]") {
   const GridGeometry grid = makeGrid({40, 40, 40});
-  const Brick whole = makeVolume(grid, ScalarType::kUInt8, [](Vec3 p) { return p.x + p.y; });
+  const Brick whole = floatVolume(grid, [](Vec3 p) { return p.x + p.y; });
   const KdTree tree = KdTree::build(grid, 6, SplitAxisRule::kAlternating);
   RenderOptions plain, shaded, pre;
   plain.step = shaded.step = 0.5;
@@ -486,7 +498,7 @@ TEST_CASE("storedBox holds the ghost layers ghostLayers asks for and no more", "
 TEST_CASE("k-d bricks composited in visibilityOrder equal the whole", "[kd]") {
   static ThreadPool pool(2);
   const GridGeometry grid = makeGrid({40, 40, 40}, {1, 1, 1}, {-19.5, -19.5, -19.5});
-  const Brick whole = makeVolume(grid, ScalarType::kFloat32, [](Vec3 p) {
+  const Brick whole = floatVolume(grid, [](Vec3 p) {
     auto gauss = [&](Vec3 c, double s) { return std::exp(-dot(p - c, p - c) / (2 * s * s)); };
     return std::min(
         1.0, 0.8 * gauss({-5, -3, 2}, 7) + 0.7 * gauss({7, 6, -4}, 5) + 0.5 * gauss({2, 9, 8}, 3));
