@@ -1,5 +1,9 @@
 #include "mpi_communicator.h"
 
+// The C API only: Open MPI and MPICH would otherwise drag in their
+// deprecated C++ bindings, which need a library of their own.
+#define OMPI_SKIP_MPICXX 1
+#define MPICH_SKIP_MPICXX 1
 #include <mpi.h>
 
 #include <climits>

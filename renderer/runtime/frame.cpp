@@ -1,0 +1,99 @@
+#include "frame.h"
+
+#include <chrono>
+#include <cstring>
+
+#include "camera.h"
+#include "raycast/raycaster.h"
+#include "scene_volume.h"
+#include "thread_pool.h"
+
+namespace pvr::runtime {
+
+using composite::runAgreed;
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::vector<RankReport> gatherReports(const RankReport& mine, composite::Communicator& comm) {
+  composite::Bytes bytes(sizeof mine);
+  std::memcpy(bytes.data(), &mine, sizeof mine);
+  std::vector<RankReport> all;
+  for (const composite::Bytes& b : comm.allGather(bytes)) {
+    RankReport r;
+    if (b.size() != sizeof r) throw Error(ErrorCode::kInternal, "rank report of the wrong size");
+    std::memcpy(&r, b.data(), sizeof r);
+    all.push_back(r);
+  }
+  return all;
+}
+
+}  // namespace
+
+FrameResult renderFrame(const core::Scene& sceneIn, const FrameOptions& options,
+                        composite::Communicator& comm) {
+  FrameResult result;
+  RankReport report;
+
+  // Open the volume, resolve the scene, choose the strategy.
+  const auto distStart = std::chrono::steady_clock::now();
+  std::unique_ptr<core::VolumeSource> source;
+  std::unique_ptr<composite::Strategy> strategy;
+  core::RenderOptions renderOptions;
+  runAgreed(comm, [&] {
+    strategy = composite::makeStrategy(options.strategy, options.strategyParams);
+    source = options.openVolume ? options.openVolume(sceneIn.volume) : core::openSceneVolume(sceneIn.volume);
+    result.scene = sceneIn;
+    core::resolveDefaults(result.scene, source->grid());
+    if (options.earlyTermination) {
+      if (!(*options.earlyTermination > 0 && *options.earlyTermination <= 1))
+        throw Error(ErrorCode::kInvalidArgument, "early termination must be in (0, 1]");
+      result.scene.sampling.earlyTermination = *options.earlyTermination;
+    }
+    renderOptions = core::renderOptionsFor(result.scene);
+    result.ghostLayers = core::ghostLayers(source->grid(), renderOptions);
+    result.volume = source->describe();
+    result.volumeBytes = std::uint64_t(source->grid().allNodes().nodeCount()) * core::scalarSize(source->type());
+  });
+
+  // Each rank gets its brick.
+  Distribution dist =
+      distributeBricks(*source, result.scene, options.decomposition, result.ghostLayers, comm);
+  result.readPartially = dist.readPartially;
+  result.rootReadBytes = dist.rootReadBytes;
+  report.brickBytes = dist.brick.byteSize();
+  report.dist = secondsSince(distStart);
+
+  // Render my brick into its screen rectangle.
+  core::Image partial;
+  std::optional<core::Camera> camera;
+  runAgreed(comm, [&] {
+    camera.emplace(result.scene.camera, result.scene.image.width, result.scene.image.height);
+    core::ThreadPool pool(options.threads);
+    core::BrickRenderer renderer(dist.brick);
+    renderer.classify(result.scene.transfer, renderOptions);
+    const auto start = std::chrono::steady_clock::now();
+    partial = renderer.render(*camera, renderOptions, pool);
+    report.rend = secondsSince(start);
+  });
+
+  // Composite; the strategy's preconditions hold on every rank by now.
+  composite::CompositeResult composite;
+  runAgreed(comm, [&] {
+    composite::CompositeOptions compositeOptions;
+    compositeOptions.codec = options.codec;
+    composite = strategy->composite(partial, dist.tree, *camera, comm, compositeOptions);
+  });
+  report.composite = composite.stats;
+  report.comp = composite.stats.computeSeconds;
+  report.comm = composite.stats.communicationSeconds;
+  report.send = composite.stats.gatherSeconds;
+  result.ranks = gatherReports(report, comm);
+  if (comm.rank() == 0) result.image = std::move(composite.image);
+  return result;
+}
+
+}  // namespace pvr::runtime
