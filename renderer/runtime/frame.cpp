@@ -33,18 +33,18 @@ std::vector<RankReport> gatherReports(const RankReport& mine, composite::Communi
 
 }  // namespace
 
-FrameResult renderFrame(const core::Scene& sceneIn, const FrameOptions& options,
-                        composite::Communicator& comm) {
-  FrameResult result;
-  RankReport report;
+PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& options,
+                           composite::Communicator& comm) {
+  PreparedFrame prepared;
+  FrameResult& result = prepared.frame;
+  RankReport& report = prepared.report;
 
-  // Open the volume, resolve the scene, choose the strategy.
+  // Open the volume, resolve the scene, check the strategy's name.
   const auto distStart = std::chrono::steady_clock::now();
   std::unique_ptr<core::VolumeSource> source;
-  std::unique_ptr<composite::Strategy> strategy;
   core::RenderOptions renderOptions;
   runAgreed(comm, [&] {
-    strategy = composite::makeStrategy(options.strategy, options.strategyParams);
+    composite::makeStrategy(options.strategy, options.strategyParams);
     source = options.openVolume ? options.openVolume(sceneIn.volume) : core::openSceneVolume(sceneIn.volume);
     result.scene = sceneIn;
     core::resolveDefaults(result.scene, source->grid());
@@ -60,32 +60,37 @@ FrameResult renderFrame(const core::Scene& sceneIn, const FrameOptions& options,
   });
 
   // Each rank gets its brick.
-  Distribution dist =
-      distributeBricks(*source, result.scene, options.decomposition, result.ghostLayers, comm);
-  result.readPartially = dist.readPartially;
-  result.rootReadBytes = dist.rootReadBytes;
-  report.brickBytes = dist.brick.byteSize();
+  prepared.bricks = distributeBricks(*source, result.scene, options.decomposition, result.ghostLayers, comm);
+  result.readPartially = prepared.bricks.readPartially;
+  result.rootReadBytes = prepared.bricks.rootReadBytes;
+  report.brickBytes = prepared.bricks.brick.byteSize();
   report.dist = secondsSince(distStart);
 
   // Render my brick into its screen rectangle.
-  core::Image partial;
-  std::optional<core::Camera> camera;
   runAgreed(comm, [&] {
-    camera.emplace(result.scene.camera, result.scene.image.width, result.scene.image.height);
+    prepared.camera.emplace(result.scene.camera, result.scene.image.width, result.scene.image.height);
     core::ThreadPool pool(options.threads);
-    core::BrickRenderer renderer(dist.brick);
+    core::BrickRenderer renderer(prepared.bricks.brick);
     renderer.classify(result.scene.transfer, renderOptions);
     const auto start = std::chrono::steady_clock::now();
-    partial = renderer.render(*camera, renderOptions, pool);
+    prepared.partial = renderer.render(*prepared.camera, renderOptions, pool);
     report.rend = secondsSince(start);
   });
+  return prepared;
+}
 
-  // Composite; the strategy's preconditions hold on every rank by now.
+FrameResult compositeFrame(const PreparedFrame& prepared, const FrameOptions& options,
+                           composite::Communicator& comm) {
+  FrameResult result = prepared.frame;
+  RankReport report = prepared.report;
+  // The strategy's preconditions hold on every rank by now.
   composite::CompositeResult composite;
   runAgreed(comm, [&] {
+    const auto strategy = composite::makeStrategy(options.strategy, options.strategyParams);
     composite::CompositeOptions compositeOptions;
     compositeOptions.codec = options.codec;
-    composite = strategy->composite(partial, dist.tree, *camera, comm, compositeOptions);
+    composite = strategy->composite(prepared.partial, prepared.bricks.tree, *prepared.camera, comm,
+                                    compositeOptions);
   });
   report.composite = composite.stats;
   report.comp = composite.stats.computeSeconds;
@@ -94,6 +99,11 @@ FrameResult renderFrame(const core::Scene& sceneIn, const FrameOptions& options,
   result.ranks = gatherReports(report, comm);
   if (comm.rank() == 0) result.image = std::move(composite.image);
   return result;
+}
+
+FrameResult renderFrame(const core::Scene& scene, const FrameOptions& options,
+                        composite::Communicator& comm) {
+  return compositeFrame(prepareFrame(scene, options, comm), options, comm);
 }
 
 }  // namespace pvr::runtime

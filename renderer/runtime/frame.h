@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "camera.h"
 #include "communicator.h"
 #include "distribute.h"
 #include "image.h"
@@ -60,5 +61,20 @@ struct FrameResult {
 // (message "rank R: ..." of the lowest failing rank).
 FrameResult renderFrame(const core::Scene& scene, const FrameOptions& options,
                         composite::Communicator& comm);
+
+// renderFrame in its two halves, for benchmarks that composite one
+// rendering many ways: prepareFrame opens, distributes and renders (dist,
+// rend); compositeFrame composites with options.strategy and options.codec.
+struct PreparedFrame {
+  FrameResult frame;      // scene, volume facts; no image or reports yet
+  Distribution bricks;
+  core::Image partial;    // this rank's rendered brick
+  std::optional<core::Camera> camera;
+  RankReport report;      // dist, rend, brickBytes
+};
+PreparedFrame prepareFrame(const core::Scene& scene, const FrameOptions& options,
+                           composite::Communicator& comm);
+FrameResult compositeFrame(const PreparedFrame& prepared, const FrameOptions& options,
+                           composite::Communicator& comm);
 
 }  // namespace pvr::runtime
