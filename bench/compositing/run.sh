@@ -91,7 +91,9 @@ plot '$data/1024-binary-swap-rle.dat' using 1:18 with linespoints title 'binary-
 
 set output '$out/breakdown.png'
 set multiplot layout 1,2 title 'time breakdown, max over ranks (Table 1 of Ma et al.), 512 x 512, RLE'
-set ylabel 'seconds'
+set ylabel 'seconds (log scale)'
+set logscale y
+set key bottom right
 set title 'binary-swap'
 plot '$data/512-binary-swap-rle.dat' using 1:10 with linespoints title 'dist', \
      '' using 1:11 with linespoints title 'rend', \

@@ -71,6 +71,8 @@ std::string formatReport(const FrameResult& result, const FrameOptions& options)
   out += line("voxels per rank: at most %.3f MB, mean %.3f MB; volume / ranks = %.3f MB (%d ghost layers, %s)\n",
               maxBrick * 1e-6, sumBrick * 1e-6 / n, result.volumeBytes * 1e-6 / n, result.ghostLayers,
               result.readPartially ? "each rank read its own brick" : "rank 0 read the volume and scattered");
+  if (!result.readPartially)
+    out += line("rank 0 held the whole volume (%.3f MB) while scattering\n", result.rootReadBytes * 1e-6);
   return out;
 }
 
