@@ -1,0 +1,75 @@
+// Connection: one non-blocking TCP connection to pvrd on the Tcl event loop.
+//
+// Connecting, reading and writing all happen in Tcl file handlers
+// (Tcl_CreateFileHandler), so any number of connections and a Tk GUI stay
+// live at once. Bytes in go through a FrameDecoder; each decoded message is
+// handed to the Listener. Bytes out are queued and written as the socket
+// accepts them. The connection never blocks the interpreter.
+#pragma once
+
+#include <tcl.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pvr_protocol.h"
+#include "tcl_util.h"
+
+namespace pvr::tcl {
+
+class Connection {
+ public:
+  // What the owner hears. A listener may destroy the Connection from inside
+  // any of these calls; the connection notices and touches nothing after.
+  class Listener {
+   public:
+    virtual ~Listener() = default;
+    virtual void onConnected() = 0;                            // the TCP connect finished
+    virtual void onMessage(const proto::Decoded& message) = 0; // one decoded frame
+    virtual void onFailure(const TclError& error) = 0;         // once; the socket is closed after it
+  };
+
+  // Resolves `host` and starts a non-blocking connect; onConnected or
+  // onFailure follows from the event loop, onFailure with {PVR CONNECT
+  // TIMEOUT} after `timeoutSeconds`. Throws TclError {PVR CONNECT RESOLVE}
+  // or {PVR CONNECT SOCKET} for failures known at once.
+  Connection(Listener& listener, const std::string& host, int port, double timeoutSeconds);
+  ~Connection();
+  Connection(const Connection&) = delete;
+  Connection& operator=(const Connection&) = delete;
+
+  // Queues one frame and writes what the socket takes now. Returns false
+  // once the connection has failed or closed (the frame is dropped).
+  bool send(const proto::Message& message, std::uint32_t requestId);
+
+  bool connected() const { return state_ == State::kConnected; }
+  bool failed() const { return state_ == State::kFailed; }
+  const std::string& peer() const { return peer_; }
+
+ private:
+  enum class State { kConnecting, kConnected, kFailed };
+
+  static void fileProc(ClientData data, int mask);
+  static void timeoutProc(ClientData data);
+  void finishConnect();
+  void readSome();
+  void writeSome();
+  void updateMask();
+  void fail(std::vector<std::string> code, const std::string& message);
+  void closeSocket();
+
+  Listener& listener_;
+  std::string peer_;  // "host:port" for messages
+  int fd_ = -1;
+  State state_ = State::kConnecting;
+  int mask_ = 0;                          // file handler mask in force
+  Tcl_TimerToken timer_ = nullptr;        // connect timeout
+  std::vector<std::uint8_t> out_;         // bytes queued for the socket
+  std::size_t outDone_ = 0;               // bytes of out_ already written
+  proto::FrameDecoder decoder_;
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);  // false once destroyed
+};
+
+}  // namespace pvr::tcl

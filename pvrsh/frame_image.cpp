@@ -1,0 +1,137 @@
+#include "frame_image.h"
+
+#include <tk.h>
+#include <zlib.h>
+
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+#include "tcl_util.h"
+
+namespace pvr::tcl {
+namespace {
+
+[[noreturn]] void malformed(const std::string& what) {
+  throw TclError({"PVR", "PROTOCOL", "MALFORMED_PAYLOAD"}, "bad image frame: " + what);
+}
+
+void putU32(std::vector<std::uint8_t>& out, std::uint32_t v) {
+  for (int shift = 24; shift >= 0; shift -= 8) out.push_back(std::uint8_t(v >> shift));
+}
+
+// One PNG chunk: length, type, data, CRC over type and data.
+void putChunk(std::vector<std::uint8_t>& out, const char type[4], const std::vector<std::uint8_t>& data) {
+  putU32(out, std::uint32_t(data.size()));
+  const std::size_t crcStart = out.size();
+  out.insert(out.end(), type, type + 4);
+  out.insert(out.end(), data.begin(), data.end());
+  putU32(out, std::uint32_t(crc32(0, out.data() + crcStart, uInt(out.size() - crcStart))));
+}
+
+}  // namespace
+
+Pixels decodePixels(const proto::ImageFrame& frame) {
+  Pixels p;
+  p.width = int(frame.width);
+  p.height = int(frame.height);
+  p.channels = int(proto::channelCount(frame.format));
+  const std::size_t size = std::size_t(frame.width) * frame.height * std::size_t(p.channels);
+  switch (frame.compression) {
+    case proto::Compression::kNone:
+      if (frame.pixels.size() != size) malformed("uncompressed pixel count does not match the size");
+      p.bytes = frame.pixels;
+      return p;
+    case proto::Compression::kZlib: {
+      // Inflate into exactly `size` bytes; a stream that wants more, or ends
+      // early, is malformed (docs/protocol.md: the receiver must stop there).
+      p.bytes.resize(size);
+      z_stream z{};
+      if (inflateInit(&z) != Z_OK) malformed("zlib cannot start");
+      z.next_in = const_cast<Bytef*>(frame.pixels.data());
+      z.avail_in = uInt(frame.pixels.size());
+      z.next_out = p.bytes.data();
+      z.avail_out = uInt(size);
+      const int rc = inflate(&z, Z_FINISH);
+      const std::size_t produced = size - z.avail_out;
+      inflateEnd(&z);
+      if (rc != Z_STREAM_END || produced != size) malformed("the zlib stream does not inflate to width x height pixels");
+      return p;
+    }
+    case proto::Compression::kRle:
+      break;
+  }
+  throw TclError({"PVR", "PROTOCOL", "UNSUPPORTED"},
+                 "image frame uses RLE compression, which pvrsh does not decode for 8-bit frames (zlib and none are "
+                 "supported)");
+}
+
+void writePng(const Pixels& pixels, const std::string& path) {
+  // Raw scanlines, each led by filter byte 0 (None).
+  const std::size_t row = std::size_t(pixels.width) * std::size_t(pixels.channels);
+  std::vector<std::uint8_t> raw;
+  raw.reserve((row + 1) * std::size_t(pixels.height));
+  for (int y = 0; y < pixels.height; ++y) {
+    raw.push_back(0);
+    const auto* src = pixels.bytes.data() + row * std::size_t(y);
+    raw.insert(raw.end(), src, src + row);
+  }
+  uLongf zsize = compressBound(uLong(raw.size()));
+  std::vector<std::uint8_t> idat(zsize);
+  if (compress2(idat.data(), &zsize, raw.data(), uLong(raw.size()), 1) != Z_OK)
+    throw TclError({"PVR", "IO"}, "cannot compress PNG data for " + path);
+  idat.resize(zsize);
+
+  std::vector<std::uint8_t> png{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  std::vector<std::uint8_t> ihdr;
+  putU32(ihdr, std::uint32_t(pixels.width));
+  putU32(ihdr, std::uint32_t(pixels.height));
+  // Bit depth 8; colour type 6 (RGBA) or 2 (RGB); deflate; filter 0; no interlace.
+  ihdr.insert(ihdr.end(), {8, std::uint8_t(pixels.channels == 4 ? 6 : 2), 0, 0, 0});
+  putChunk(png, "IHDR", ihdr);
+  putChunk(png, "sRGB", {0});  // perceptual rendering intent: the bytes are sRGB
+  putChunk(png, "IDAT", idat);
+  putChunk(png, "IEND", {});
+
+  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "wb"), std::fclose);
+  if (!f) throw TclError({"PVR", "IO"}, "cannot write " + path + ": " + std::strerror(errno));
+  if (std::fwrite(png.data(), 1, png.size(), f.get()) != png.size())
+    throw TclError({"PVR", "IO"}, "cannot write " + path + ": " + std::strerror(errno));
+  if (std::fclose(f.release()) != 0) throw TclError({"PVR", "IO"}, "cannot write " + path + ": " + std::strerror(errno));
+}
+
+bool tkAvailable(Tcl_Interp* interp) {
+  if (!Tcl_PkgPresent(interp, "Tk", "8.6", 0)) {
+    Tcl_ResetResult(interp);
+    return false;
+  }
+  // Tk loaded after this package: its stubs table is fetched on first use.
+  if (!tkStubsPtr && !Tk_InitStubs(interp, "8.6", 0)) {
+    Tcl_ResetResult(interp);
+    return false;
+  }
+  return true;
+}
+
+void putPhoto(Tcl_Interp* interp, const std::string& photo, const Pixels& pixels) {
+  if (!tkAvailable(interp))
+    throw TclError({"PVR", "IMAGE", "NOTK"}, "image window needs Tk: package require Tk first (or run pvrsh with a display)");
+  Tk_PhotoHandle handle = Tk_FindPhoto(interp, photo.c_str());
+  if (!handle) throw TclError({"PVR", "IMAGE", "NOPHOTO"}, "image \"" + photo + "\" is not a photo image");
+  Tk_PhotoImageBlock block{};
+  block.pixelPtr = const_cast<unsigned char*>(pixels.bytes.data());
+  block.width = pixels.width;
+  block.height = pixels.height;
+  block.pixelSize = pixels.channels;
+  block.pitch = pixels.width * pixels.channels;
+  block.offset[0] = 0;
+  block.offset[1] = 1;
+  block.offset[2] = 2;
+  block.offset[3] = pixels.channels == 4 ? 3 : 0;
+  if (Tk_PhotoSetSize(interp, handle, pixels.width, pixels.height) != TCL_OK ||
+      Tk_PhotoPutBlock(interp, handle, &block, 0, 0, pixels.width, pixels.height, TK_PHOTO_COMPOSITE_SET) != TCL_OK)
+    throw TclError({"PVR", "IMAGE", "PHOTO"}, std::string("cannot put the frame into ") + photo + ": " +
+                                                 Tcl_GetStringResult(interp));
+}
+
+}  // namespace pvr::tcl

@@ -1,0 +1,42 @@
+// Frames as they arrive: pixel decoding, PNG files, Tk photo images.
+#pragma once
+
+#include <tcl.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pvr_protocol.h"
+
+namespace pvr::tcl {
+
+// A decoded frame: rows top to bottom, 8-bit sRGB, `channels` 3 (RGB) or 4
+// (RGBA, straight alpha).
+struct Pixels {
+  int width = 0;
+  int height = 0;
+  int channels = 4;
+  std::vector<std::uint8_t> bytes;
+};
+
+// The pixels of an ImageFrame. Compression none and zlib are decoded; the
+// zlib stream is inflated into exactly width * height * channels bytes and
+// must end there. RLE (the renderer's float image codec) is not an 8-bit
+// format this client reads: TclError {PVR PROTOCOL UNSUPPORTED}. Damaged
+// data: {PVR PROTOCOL MALFORMED_PAYLOAD}.
+Pixels decodePixels(const proto::ImageFrame& frame);
+
+// Writes `pixels` as an 8-bit PNG (colour type 2 or 6, no filtering, zlib
+// level 1). Throws TclError {PVR IO} when the file cannot be written.
+void writePng(const Pixels& pixels, const std::string& path);
+
+// Puts `pixels` into the Tk photo image `photo`, resizing it to the frame.
+// Throws TclError {PVR IMAGE NOTK} when Tk is not loaded in `interp` and
+// {PVR IMAGE NOPHOTO} when no photo image has that name.
+void putPhoto(Tcl_Interp* interp, const std::string& photo, const Pixels& pixels);
+
+// True when Tk is loaded in `interp` and its stubs are ready for putPhoto.
+bool tkAvailable(Tcl_Interp* interp);
+
+}  // namespace pvr::tcl

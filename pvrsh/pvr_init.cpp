@@ -1,0 +1,43 @@
+// Package pvr: Pvr_Init registers `pvr_session`, which makes session
+// objects (paper 003, Table 1). Loaded by `package require pvr`.
+#include <tcl.h>
+
+#include <string>
+
+#include "session.h"
+
+namespace pvr::tcl {
+namespace {
+
+// pvr_session NAME: creates the object command NAME (":brain") for a new,
+// closed session. Results: NAME. Side effects: a new command; an existing
+// command of that name is an error, not replaced.
+int sessionCreateCmd(ClientData, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc != 2) {
+    Tcl_WrongNumArgs(interp, 1, objv, "name");
+    Tcl_SetErrorCode(interp, "PVR", "ARGS", "WRONGNUM", nullptr);
+    return TCL_ERROR;
+  }
+  const std::string name = Tcl_GetString(objv[1]);
+  if (name.empty()) return setError(interp, {"PVR", "ARGS", "NAME"}, "pvr_session: the name must not be empty");
+  Tcl_CmdInfo info;
+  if (Tcl_GetCommandInfo(interp, name.c_str(), &info))
+    return setError(interp, {"PVR", "ARGS", "EXISTS"}, "pvr_session: command \"" + name + "\" already exists");
+  auto* session = new Session(interp, name);
+  session->token_ = Tcl_CreateObjCommand(interp, name.c_str(), Session::objCmd, session, Session::deleteCmd);
+  Tcl_SetObjResult(interp, objv[1]);
+  return TCL_OK;
+}
+
+}  // namespace
+}  // namespace pvr::tcl
+
+extern "C" __attribute__((visibility("default"))) int Pvr_Init(Tcl_Interp* interp) {
+  if (!Tcl_InitStubs(interp, "8.6", 0)) return TCL_ERROR;
+  // ::pvr::progress: when true (pvrsh running a script sets it), sequences
+  // print progress and a timing table on stderr.
+  if (Tcl_Eval(interp, "namespace eval ::pvr { if {![info exists progress]} { variable progress 0 } }") != TCL_OK)
+    return TCL_ERROR;
+  Tcl_CreateObjCommand(interp, "pvr_session", pvr::tcl::sessionCreateCmd, nullptr, nullptr);
+  return Tcl_PkgProvide(interp, "pvr", PVR_PACKAGE_VERSION);
+}

@@ -1,0 +1,75 @@
+// pvrsh: a Tk shell with package pvr loaded. With no DISPLAY, or with
+// -nogui, it is a Tcl shell. It runs a script file (pvrsh ?-nogui? FILE
+// ?ARG ...?) or reads commands interactively.
+//
+// A script run this way sets ::pvr::progress, so render sequences print
+// progress and a timing table on stderr; an error in the script exits 1.
+#include <tcl.h>
+#include <tk.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace {
+
+bool gRunsScript = false;
+
+// Finds package pvr next to the executable (installed: PREFIX/bin/../lib),
+// in the build tree, or on the usual auto_path, then loads it.
+int loadPvr(Tcl_Interp* interp) {
+  const std::string script = std::string(R"TCL(
+    set exe [file dirname [file normalize [info nameofexecutable]]]
+    foreach dir [list [file join [file dirname $exe] lib] )TCL") + "{" PVR_BUILD_PACKAGE_DIR "}" + R"TCL(] {
+      if {[file exists [file join $dir pvr pkgIndex.tcl]] && $dir ni $::auto_path} {
+        set ::auto_path [linsert $::auto_path 0 $dir]
+      }
+    }
+    unset exe dir
+    package require pvr
+  )TCL";
+  if (Tcl_Eval(interp, script.c_str()) != TCL_OK) return TCL_ERROR;
+  if (gRunsScript) Tcl_SetVar2(interp, "::pvr::progress", nullptr, "1", TCL_GLOBAL_ONLY);
+  Tcl_SetVar(interp, "tcl_rcFileName", "~/.pvrshrc", TCL_GLOBAL_ONLY);
+  return TCL_OK;
+}
+
+int tclAppInit(Tcl_Interp* interp) {
+  if (Tcl_Init(interp) != TCL_OK) return TCL_ERROR;
+  return loadPvr(interp);
+}
+
+int tkAppInit(Tcl_Interp* interp) {
+  if (Tcl_Init(interp) != TCL_OK || Tk_Init(interp) != TCL_OK) return TCL_ERROR;
+  Tcl_StaticPackage(interp, "Tk", Tk_Init, Tk_SafeInit);
+  return loadPvr(interp);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // -nogui (anywhere before the script name) chooses the Tcl shell.
+  bool gui = std::getenv("DISPLAY") && *std::getenv("DISPLAY");
+  std::vector<char*> args{argv[0]};
+  int i = 1;
+  for (; i < argc && argv[i][0] == '-'; ++i) {
+    if (std::strcmp(argv[i], "-nogui") == 0) {
+      gui = false;
+    } else if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
+      std::printf("usage: pvrsh ?-nogui? ?script.tcl ?arg ...??\n");
+      return 0;
+    } else {
+      break;
+    }
+  }
+  for (; i < argc; ++i) args.push_back(argv[i]);
+  gRunsScript = args.size() > 1;
+  args.push_back(nullptr);
+  if (gui)
+    Tk_Main(int(args.size() - 1), args.data(), tkAppInit);
+  else
+    Tcl_Main(int(args.size() - 1), args.data(), tclAppInit);
+  return 0;
+}

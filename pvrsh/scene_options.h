@@ -1,0 +1,54 @@
+// The options of `:s set`: each maps to a piece of a SetScene document
+// (docs/scene.md, sent as an RFC 7386 merge patch) or to the cluster layout
+// (SetLayout). One table row per option in scene_options.cpp.
+#pragma once
+
+#include <tcl.h>
+
+#include <cstdint>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "pvr_protocol.h"
+
+namespace pvr::tcl {
+
+// What the user has set so far; sent whole when a session opens.
+struct Settings {
+  std::string dataset;                          // catalog name; empty: none yet
+  nlohmann::json scene = nlohmann::json::object();  // every scene key set so far, merged
+  std::vector<proto::ClusterSpec> clusters;     // desired layout; empty: the master's default
+  std::vector<std::pair<std::string, std::string>> shown;  // option -> value as given, first-set order
+};
+
+// What one `set` call changed, to be sent to an open session.
+struct SettingsChange {
+  bool dataset = false;                              // -dataset given
+  nlohmann::json patch = nlohmann::json::object();   // merge patch of the scene keys given
+  bool layout = false;                               // -cluster or -group given
+};
+
+// Applies `set` options (name value pairs) to `settings`. All options are
+// checked before any is applied, so a bad one changes nothing. Throws
+// TclError {PVR ARGS OPTION} with a message naming the option and value, and
+// the standard "bad option" message for an unknown option.
+SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tcl_Obj* const objv[]);
+
+// The value last given for `option` (e.g. "-imagesz"), or an error naming
+// the known options.
+std::string shownOption(Tcl_Interp* interp, const Settings& settings, Tcl_Obj* option);
+
+// The control points [[s, r, g, b, a], ...] of a ParaView transfer-function
+// preset file (docs/scene.md, "ParaView presets"), read here so that the
+// server needs no access to the client's files.
+nlohmann::json presetPoints(const std::string& path);
+
+// A cluster layout as a Tcl list of {role ranks group} triples.
+Tcl_Obj* layoutObj(const std::vector<proto::ClusterSpec>& clusters);
+
+// A JSON value as Tcl: objects become dicts, arrays lists, null "".
+Tcl_Obj* jsonToTcl(const nlohmann::json& value);
+
+}  // namespace pvr::tcl

@@ -1,0 +1,138 @@
+// Session: the record behind one `pvr_session :name` object command.
+//
+// A session owns one connection to pvrd, the settings made with `set`, the
+// image sinks (photo, callback, files) and the render sequences in flight.
+// Every reply is handled on the Tcl event loop; `open`, `wait` and the
+// queries that need an answer (`list status`, `list datasets`,
+// `performance`) run the event loop themselves until their answer is in.
+//
+// Lifetime: the object command's delete proc calls Tcl_EventuallyFree, and
+// every entry from Tcl (commands, file handlers) brackets its work with
+// Tcl_Preserve/Tcl_Release, so a callback may delete the session it runs in.
+#pragma once
+
+#include <tcl.h>
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "connection.h"
+#include "frame_image.h"
+#include "scene_options.h"
+#include "tcl_util.h"
+
+namespace pvr::tcl {
+
+using Clock = std::chrono::steady_clock;
+
+// One frame's record: the server's timing breakdown and when it arrived.
+struct FrameRecord {
+  std::uint32_t frame = 0;
+  proto::FrameTiming timing;
+  double arrival = 0;  // seconds since the request was sent
+  int width = 0, height = 0;
+};
+
+// A render request in flight: RenderFrame or RenderRotation.
+struct Sequence {
+  std::uint32_t id = 0;      // request id
+  std::string label;         // "rotate 0,1,0 15,59:60" for reports
+  std::uint32_t total = 0;   // frames expected
+  Clock::time_point sent;
+  std::vector<FrameRecord> frames;
+  bool cancelled = false;    // frames still arriving are dropped
+};
+
+// A request whose answer someone waits for (open, queries) or that only
+// reports failure (SetScene, SetLayout, Cancel).
+struct Pending {
+  bool synchronous = false;             // a caller runs the event loop for it
+  bool done = false;
+  std::vector<proto::Message> replies;  // every answer up to FINAL
+  std::optional<TclError> error;
+};
+
+class Session : public Connection::Listener {
+ public:
+  enum class State { kClosed, kConnecting, kOpen, kFailed };
+
+  Session(Tcl_Interp* interp, std::string name);
+  ~Session() override;
+
+  // The object command's entry point (session_commands.cpp).
+  static int objCmd(ClientData data, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]);
+  static void deleteCmd(ClientData data);
+  static void freeProc(char* data);
+
+  // ---- Operations behind the subcommands; each throws TclError ----
+  void open(const std::string& host, int port, std::uint32_t ranks, const std::string& tokenFile, double timeout);
+  void close(const std::string& reason);
+  void applySettings(const SettingsChange& change);
+  std::uint32_t render(const proto::Message& request, std::uint32_t total, const std::string& label);
+  int cancel();
+  std::size_t wait(double timeoutSeconds);
+  std::vector<proto::Message> query(const proto::Message& request, double timeoutSeconds);
+  Tcl_Obj* statusObj();
+  Tcl_Obj* timingObj() const;
+  // Throws {PVR STATE NOTOPEN} naming `what` unless the session is open.
+  void requireOpen(const char* what) const;
+
+  // ---- Connection::Listener ----
+  void onConnected() override {}
+  void onMessage(const proto::Decoded& message) override;
+  void onFailure(const TclError& error) override;
+
+  Tcl_Interp* interp_;
+  Tcl_Command token_ = nullptr;
+  std::string name_;
+  Settings settings_;
+  std::uint32_t ranksWanted_ = 0;
+
+  // Image sinks (image window|callback|file|dir); empty: off.
+  std::string photo_;
+  Tcl_Obj* callback_ = nullptr;  // command prefix; frame and timing appended
+  Tcl_Obj* notify_ = nullptr;    // command prefix; event and details appended
+  std::string filePattern_;     // printf pattern of one %05llu: the numbered PNGs
+  std::string animatedTarget_;  // .gif or .mp4 that ffmpeg assembles; empty: none
+  std::string dir_;
+
+ private:
+  std::uint32_t send(const proto::Message& message, bool synchronous);
+  void handleFrame(Sequence& seq, const proto::ImageFrame& frame, bool final);
+  void finishSequence(std::uint32_t id);
+  void report(const TclError& error);
+  void notify(const char* event, std::vector<Tcl_Obj*> details);
+  void printProgress(const Sequence& seq) const;
+  void printTable(const Sequence& seq) const;
+  void assembleAnimation(const Sequence& seq);
+  // Runs the event loop until done() or `timeoutSeconds` pass; false on timeout.
+  template <class Done>
+  bool runEventsUntil(Done done, double timeoutSeconds);
+
+  State state_ = State::kClosed;
+  std::unique_ptr<Connection> conn_;
+  std::string peer_;
+  std::string serverSoftware_;
+  std::uint32_t maxRanks_ = 0;
+  std::uint32_t ranks_ = 0;                       // started, as SessionReady said
+  std::vector<proto::ClusterSpec> layout_;        // in force, as SessionReady said
+  std::uint32_t nextId_ = 1;
+  std::map<std::uint32_t, Pending> pending_;
+  std::map<std::uint32_t, Sequence> sequences_;   // in flight, by request id
+  std::map<std::uint32_t, bool> dropped_;         // cancelled ids whose answers are ignored
+  Sequence last_;                                 // the most recent sequence, finished or not
+  std::uint64_t framesReceived_ = 0;              // numbers the files of `image dir|file`
+  std::uint64_t firstFileNumber_ = 0;             // number of a sequence's first `image file` PNG
+  int waiters_ = 0;                               // `wait` calls running
+  std::optional<TclError> waitError_;             // first error while waiting
+  std::optional<TclError> lastFailure_;          // why the connection ended
+  std::string closeReason_;                       // the server's Close reason
+  bool deleted_ = false;
+};
+
+}  // namespace pvr::tcl

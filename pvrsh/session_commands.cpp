@@ -1,0 +1,387 @@
+// The subcommands of a session object (paper 003, Table 1), one handler per
+// row of kSubcommands. Handlers throw TclError; objCmd turns it into the
+// interpreter's result and -errorcode.
+#include <tk.h>
+
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+
+#include "session.h"
+
+namespace pvr::tcl {
+namespace {
+
+using Handler = int (*)(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]);
+
+struct Subcommand {
+  const char* name;  // first field: Tcl_GetIndexFromObjStruct reads it
+  Handler handler;
+};
+
+std::string str(Tcl_Obj* o) { return Tcl_GetString(o); }
+
+// Splits HOST[:PORT]; the port defaults to kDefaultPort.
+constexpr int kDefaultPort = 7350;
+void splitHostPort(const std::string& address, std::string& host, int& port) {
+  const auto colon = address.rfind(':');
+  port = kDefaultPort;
+  host = address;
+  if (colon != std::string::npos && address.find(':') == colon) {
+    host = address.substr(0, colon);
+    port = int(parseInteger("-port", address.substr(colon + 1), 1, 65535));
+  }
+  if (host.empty()) argsError("HOST", "open: no host in '" + address + "'");
+}
+
+// :s open HOST[:PORT] ?-ranks N? ?-token-file F? ?-timeout S?
+int openCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc < 3 || objc % 2 == 0) {
+    Tcl_WrongNumArgs(interp, 2, objv, "host?:port? ?-ranks n? ?-token-file file? ?-timeout seconds?");
+    return TCL_ERROR;
+  }
+  static const char* const kOptions[] = {"-ranks", "-timeout", "-token-file", nullptr};
+  std::uint32_t ranks = s.ranksWanted_;
+  std::string tokenFile;
+  if (const char* env = std::getenv("PVR_TOKEN_FILE")) tokenFile = env;
+  double timeout = 30;
+  for (int i = 3; i < objc; i += 2) {
+    int index = 0;
+    if (Tcl_GetIndexFromObj(interp, objv[i], kOptions, "option", 0, &index) != TCL_OK)
+      throw TclError({"PVR", "ARGS", "OPTION"}, Tcl_GetStringResult(interp));
+    const std::string v = str(objv[i + 1]);
+    if (index == 0) ranks = std::uint32_t(parseInteger("-ranks", v, 1, 1 << 20));
+    if (index == 1) timeout = parseNumbers("-timeout", v, 1)[0];
+    if (index == 2) tokenFile = v;
+  }
+  if (!(timeout > 0)) argsError("TIMEOUT", "-timeout must be > 0 seconds");
+  std::string host;
+  int port = 0;
+  splitHostPort(str(objv[2]), host, port);
+  s.ranksWanted_ = ranks;
+  s.open(host, port, ranks, tokenFile, timeout);
+  return TCL_OK;
+}
+
+int closeCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc != 2) {
+    Tcl_WrongNumArgs(interp, 2, objv, nullptr);
+    return TCL_ERROR;
+  }
+  s.close("pvrsh: session closed");
+  return TCL_OK;
+}
+
+// A pattern for numbered PNG files from `image file F`: F with one %d
+// (optionally %0Nd) numbers the frames; otherwise _00000 goes before the
+// extension. F ending in .gif or .mp4 names an animated file: the PNGs go
+// beside it and ffmpeg assembles them after each sequence.
+void filePattern(const std::string& file, std::string& pattern, std::string& animated) {
+  animated.clear();
+  const auto dot = file.rfind('.');
+  const std::string ext = dot == std::string::npos ? "" : file.substr(dot);
+  const std::string stem = dot == std::string::npos ? file : file.substr(0, dot);
+  if (ext == ".gif" || ext == ".mp4") {
+    animated = file;
+    pattern = stem + "_%05llu.png";
+    return;
+  }
+  const auto pct = file.find('%');
+  if (pct == std::string::npos) {
+    pattern = stem + "_%05llu" + (ext == ".png" ? ext : ext + ".png");
+    return;
+  }
+  std::size_t end = pct + 1;
+  while (end < file.size() && std::isdigit(static_cast<unsigned char>(file[end]))) ++end;
+  if (end >= file.size() || file[end] != 'd' || file.find('%', end) != std::string::npos)
+    argsError("FILE", "image file: a pattern takes one %d or %0Nd, got '" + file + "'");
+  pattern = file.substr(0, end) + "llu" + file.substr(end + 1);
+}
+
+// :s image window|callback|file|dir ?VALUE?  (no value: the current one)
+int imageCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  static const char* const kKinds[] = {"callback", "dir", "file", "window", nullptr};
+  if (objc != 3 && objc != 4) {
+    Tcl_WrongNumArgs(interp, 2, objv, "window|callback|file|dir ?value?");
+    return TCL_ERROR;
+  }
+  int kind = 0;
+  if (Tcl_GetIndexFromObj(interp, objv[2], kKinds, "image target", 0, &kind) != TCL_OK)
+    throw TclError({"PVR", "ARGS", "IMAGE"}, Tcl_GetStringResult(interp));
+  if (objc == 3) {
+    const std::string values[] = {"", s.dir_, s.animatedTarget_.empty() ? s.filePattern_ : s.animatedTarget_, s.photo_};
+    Tcl_SetObjResult(interp, kind == 0 ? (s.callback_ ? s.callback_ : Tcl_NewObj()) : Tcl_NewStringObj(values[kind].c_str(), -1));
+    return TCL_OK;
+  }
+  const std::string v = str(objv[3]);
+  switch (kind) {
+    case 0:
+      if (s.callback_) Tcl_DecrRefCount(s.callback_);
+      s.callback_ = nullptr;
+      if (!v.empty()) {
+        s.callback_ = objv[3];
+        Tcl_IncrRefCount(s.callback_);
+      }
+      break;
+    case 1:
+      if (!v.empty()) {
+        Tcl_Obj* path = objv[3];
+        if (Tcl_FSCreateDirectory(path) != TCL_OK && Tcl_FSAccess(path, 2) != 0)
+          throw TclError({"PVR", "IO"}, "image dir: cannot create or write " + v);
+      }
+      s.dir_ = v;
+      break;
+    case 2:
+      if (v.empty()) {
+        s.filePattern_.clear();
+        s.animatedTarget_.clear();
+      } else {
+        filePattern(v, s.filePattern_, s.animatedTarget_);
+      }
+      break;
+    case 3:
+      if (!v.empty()) {
+        if (!tkAvailable(interp))
+          throw TclError({"PVR", "IMAGE", "NOTK"}, "image window needs Tk: package require Tk first (or run pvrsh with a display)");
+        if (!Tk_FindPhoto(interp, v.c_str()))
+          throw TclError({"PVR", "IMAGE", "NOPHOTO"}, "image \"" + v + "\" is not a photo image");
+      }
+      s.photo_ = v;
+      break;
+  }
+  return TCL_OK;
+}
+
+// :s list status | :s list datasets
+int listCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  static const char* const kWhat[] = {"datasets", "status", nullptr};
+  if (objc != 3) {
+    Tcl_WrongNumArgs(interp, 2, objv, "status|datasets");
+    return TCL_ERROR;
+  }
+  int what = 0;
+  if (Tcl_GetIndexFromObj(interp, objv[2], kWhat, "list", 0, &what) != TCL_OK)
+    throw TclError({"PVR", "ARGS", "LIST"}, Tcl_GetStringResult(interp));
+  if (what == 1) {
+    Tcl_SetObjResult(interp, s.statusObj());
+    return TCL_OK;
+  }
+  s.requireOpen("list datasets");
+  Tcl_Obj* list = Tcl_NewListObj(0, nullptr);
+  for (const auto& m : s.query(proto::CatalogRequest{}, 30))
+    if (const auto* c = std::get_if<proto::CatalogReply>(&m))
+      for (const auto& name : c->datasets) Tcl_ListObjAppendElement(nullptr, list, Tcl_NewStringObj(name.c_str(), -1));
+  Tcl_SetObjResult(interp, list);
+  return TCL_OK;
+}
+
+// :s set OPTION VALUE ?OPTION VALUE ...?  |  :s set OPTION (its value)
+int setCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc < 3) {
+    Tcl_WrongNumArgs(interp, 2, objv, "option ?value option value ...?");
+    return TCL_ERROR;
+  }
+  if (objc == 3) {
+    Tcl_SetObjResult(interp, Tcl_NewStringObj(shownOption(interp, s.settings_, objv[2]).c_str(), -1));
+    return TCL_OK;
+  }
+  // Figure 5 writes "-imagesz 512,512"; "-imagesz 512, 512" (two words) is
+  // the same request, so a value ending in a comma takes the next word too.
+  std::vector<Tcl_Obj*> words;
+  for (int i = 2; i < objc; ++i) {
+    const std::string w = str(objv[i]);
+    if (!words.empty() && i > 3 && str(words.back()).back() == ',' && w[0] != '-') {
+      Tcl_Obj* joined = Tcl_NewStringObj((str(words.back()) + w).c_str(), -1);
+      words.back() = joined;
+      continue;
+    }
+    words.push_back(objv[i]);
+  }
+  for (Tcl_Obj* o : words) Tcl_IncrRefCount(o);
+  try {
+    if (words.size() % 2 != 0) argsError("VALUE", "value for \"" + str(words.back()) + "\" missing");
+    s.applySettings(applyOptions(interp, s.settings_, int(words.size()), words.data()));
+  } catch (...) {
+    for (Tcl_Obj* o : words) Tcl_DecrRefCount(o);
+    throw;
+  }
+  for (Tcl_Obj* o : words) Tcl_DecrRefCount(o);
+  Tcl_ResetResult(interp);
+  return TCL_OK;
+}
+
+// :s render rotate|rotation X,Y,Z S,E:N  |  :s render frame
+int renderCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  static const char* const kKinds[] = {"frame", "rotate", "rotation", nullptr};
+  if (objc < 3) {
+    Tcl_WrongNumArgs(interp, 2, objv, "rotate axis start,end:steps | frame");
+    return TCL_ERROR;
+  }
+  int kind = 0;
+  if (Tcl_GetIndexFromObj(interp, objv[2], kKinds, "render", 0, &kind) != TCL_OK)
+    throw TclError({"PVR", "ARGS", "RENDER"}, Tcl_GetStringResult(interp));
+  if (kind == 0) {
+    if (objc != 3) {
+      Tcl_WrongNumArgs(interp, 3, objv, nullptr);
+      return TCL_ERROR;
+    }
+    s.render(proto::RenderFrame{}, 1, "frame");
+    Tcl_SetObjResult(interp, Tcl_NewIntObj(1));
+    return TCL_OK;
+  }
+  if (objc != 5) {
+    Tcl_WrongNumArgs(interp, 3, objv, "axis start,end:steps");
+    return TCL_ERROR;
+  }
+  const std::string axisText = str(objv[3]), range = str(objv[4]);
+  const auto axis = parseNumbers("-axis", axisText, 3);
+  if (axis[0] == 0 && axis[1] == 0 && axis[2] == 0) argsError("AXIS", "render rotate: the axis must not be 0,0,0");
+  // S,E:N: steps S to E of a full turn of N steps.
+  const auto colon = range.find(':'), comma = range.find(',');
+  if (colon == std::string::npos || comma == std::string::npos || comma > colon)
+    argsError("RANGE", "render rotate: the range is START,END:STEPS (e.g. 15,59:60), got '" + range + "'");
+  const long start = parseInteger("-start", range.substr(0, comma), -(1L << 30), 1L << 30);
+  const long end = parseInteger("-end", range.substr(comma + 1, colon - comma - 1), -(1L << 30), 1L << 30);
+  const long steps = parseInteger("-steps", range.substr(colon + 1), 1, 1L << 30);
+  if (end < start) argsError("RANGE", "render rotate: END must not be below START in '" + range + "'");
+  if (end - start >= 100000) argsError("RANGE", "render rotate: at most 100000 frames per request");
+  proto::RenderRotation r;
+  r.axis = {axis[0], axis[1], axis[2]};
+  r.start = std::int32_t(start);
+  r.end = std::int32_t(end);
+  r.stepsPerTurn = std::uint32_t(steps);
+  const auto frames = std::uint32_t(end - start + 1);
+  s.render(r, frames, "rotate " + axisText + " " + range);
+  Tcl_SetObjResult(interp, Tcl_NewWideIntObj(frames));
+  return TCL_OK;
+}
+
+// :s performance memory ?cluster? ?INDEX?
+// :s performance comp ?cluster? ?latency? ?INDEX?
+int performanceCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  static const char* const kQueries[] = {"memory", "comp", nullptr};
+  if (objc < 3 || objc > 6) {
+    Tcl_WrongNumArgs(interp, 2, objv, "memory ?cluster? ?index? | comp ?cluster? ?latency? ?index?");
+    return TCL_ERROR;
+  }
+  int query = 0;
+  if (Tcl_GetIndexFromObj(interp, objv[2], kQueries, "performance query", 0, &query) != TCL_OK)
+    throw TclError({"PVR", "ARGS", "PERFORMANCE"}, Tcl_GetStringResult(interp));
+  std::uint32_t cluster = proto::kAllClusters;
+  for (int i = 3; i < objc; ++i) {
+    const std::string w = str(objv[i]);
+    if (w == "cluster" || (query == 1 && w == "latency")) continue;
+    if (w == "all") continue;
+    cluster = std::uint32_t(parseInteger("-cluster", w, 0, 0xFFFFFFFEL));
+  }
+  s.requireOpen("performance");
+  const auto replies = s.query(proto::PerformanceRequest{query == 0 ? proto::PerformanceQuery::kMemory
+                                                                    : proto::PerformanceQuery::kCompositing,
+                                                         cluster},
+                               120);
+  for (const auto& m : replies)
+    if (const auto* r = std::get_if<proto::PerformanceReply>(&m)) {
+      nlohmann::json doc;
+      try {
+        doc = nlohmann::json::parse(r->json);
+      } catch (const std::exception& e) {
+        throw TclError({"PVR", "PROTOCOL", "MALFORMED_PAYLOAD"}, std::string("performance reply is not JSON: ") + e.what());
+      }
+      Tcl_SetObjResult(interp, jsonToTcl(doc.contains("clusters") ? doc["clusters"] : doc));
+      return TCL_OK;
+    }
+  throw TclError({"PVR", "PROTOCOL", "UNEXPECTED_MESSAGE"}, "performance: the server sent no PerformanceReply");
+}
+
+int cancelCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc != 2) {
+    Tcl_WrongNumArgs(interp, 2, objv, nullptr);
+    return TCL_ERROR;
+  }
+  Tcl_SetObjResult(interp, Tcl_NewIntObj(s.cancel()));
+  return TCL_OK;
+}
+
+// :s wait ?-timeout S?
+int waitCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc != 2 && objc != 4) {
+    Tcl_WrongNumArgs(interp, 2, objv, "?-timeout seconds?");
+    return TCL_ERROR;
+  }
+  double timeout = 1e6;
+  if (objc == 4) {
+    static const char* const kOptions[] = {"-timeout", nullptr};
+    int index = 0;
+    if (Tcl_GetIndexFromObj(interp, objv[2], kOptions, "option", 0, &index) != TCL_OK)
+      throw TclError({"PVR", "ARGS", "OPTION"}, Tcl_GetStringResult(interp));
+    timeout = parseNumbers("-timeout", str(objv[3]), 1)[0];
+    if (!(timeout > 0)) argsError("TIMEOUT", "-timeout must be > 0 seconds");
+  }
+  Tcl_SetObjResult(interp, Tcl_NewWideIntObj(Tcl_WideInt(s.wait(timeout))));
+  return TCL_OK;
+}
+
+int timingCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc != 2) {
+    Tcl_WrongNumArgs(interp, 2, objv, nullptr);
+    return TCL_ERROR;
+  }
+  Tcl_SetObjResult(interp, s.timingObj());
+  return TCL_OK;
+}
+
+// :s notify ?PROC?: PROC event details... for done, cancelled and error.
+int notifyCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc != 2 && objc != 3) {
+    Tcl_WrongNumArgs(interp, 2, objv, "?command?");
+    return TCL_ERROR;
+  }
+  if (objc == 2) {
+    Tcl_SetObjResult(interp, s.notify_ ? s.notify_ : Tcl_NewObj());
+    return TCL_OK;
+  }
+  if (s.notify_) Tcl_DecrRefCount(s.notify_);
+  s.notify_ = nullptr;
+  if (*Tcl_GetString(objv[2])) {
+    s.notify_ = objv[2];
+    Tcl_IncrRefCount(s.notify_);
+  }
+  return TCL_OK;
+}
+
+const Subcommand kSubcommands[] = {
+    {"cancel", cancelCmd},   {"close", closeCmd},   {"image", imageCmd},   {"list", listCmd},
+    {"notify", notifyCmd},   {"open", openCmd},     {"performance", performanceCmd},
+    {"render", renderCmd},   {"set", setCmd},       {"timing", timingCmd}, {"wait", waitCmd},
+    {nullptr, nullptr}};
+
+}  // namespace
+
+int Session::objCmd(ClientData data, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  auto* self = static_cast<Session*>(data);
+  if (objc < 2) {
+    Tcl_WrongNumArgs(interp, 1, objv, "subcommand ?arg ...?");
+    return TCL_ERROR;
+  }
+  int index = 0;
+  if (Tcl_GetIndexFromObjStruct(interp, objv[1], kSubcommands, sizeof(Subcommand), "subcommand", 0, &index) != TCL_OK) {
+    Tcl_SetErrorCode(interp, "PVR", "ARGS", "SUBCOMMAND", nullptr);
+    return TCL_ERROR;
+  }
+  Tcl_Preserve(self);
+  int rc = TCL_ERROR;
+  try {
+    rc = kSubcommands[index].handler(*self, interp, objc, objv);
+    if (rc == TCL_ERROR)  // only Tcl_WrongNumArgs returns without throwing
+      Tcl_SetErrorCode(interp, "PVR", "ARGS", "WRONGNUM", nullptr);
+  } catch (const TclError& e) {
+    rc = setError(interp, e);
+  } catch (const std::exception& e) {
+    rc = setError(interp, {"PVR", "INTERNAL"}, std::string(kSubcommands[index].name) + ": " + e.what());
+  }
+  Tcl_Release(self);
+  return rc;
+}
+
+}  // namespace pvr::tcl

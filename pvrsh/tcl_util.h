@@ -1,0 +1,52 @@
+// Small helpers shared by the pvr Tcl extension: errors with -errorcode,
+// and the exception type that carries one up to the Tcl boundary.
+//
+// Inside the extension a failure throws TclError; every Tcl_ObjCmdProc and
+// every event-loop callback catches at its top, so no C++ exception unwinds
+// through Tcl frames (docs/pvrsh.md lists the codes).
+#pragma once
+
+#include <tcl.h>
+
+#include <initializer_list>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pvr::tcl {
+
+// A Tcl error: the message and the -errorcode list, e.g. {PVR ARGS IMAGESZ}.
+class TclError : public std::runtime_error {
+ public:
+  TclError(std::vector<std::string> code, const std::string& message)
+      : std::runtime_error(message), code_(std::move(code)) {}
+  const std::vector<std::string>& code() const { return code_; }
+
+ private:
+  std::vector<std::string> code_;
+};
+
+// Throws TclError{{"PVR", "ARGS", what}, message}.
+[[noreturn]] void argsError(const std::string& what, const std::string& message);
+
+// Sets the interpreter's result and -errorcode from `error`; returns TCL_ERROR.
+int setError(Tcl_Interp* interp, const TclError& error);
+
+// The same for a message and code list given apart.
+int setError(Tcl_Interp* interp, std::initializer_list<std::string> code, const std::string& message);
+
+// Makes a Tcl list object of strings.
+Tcl_Obj* listOf(const std::vector<std::string>& items);
+
+// Parses "X,Y,Z"-style number lists: separators are commas, spaces or an 'x'
+// (for "512x512"). Throws argsError naming `option` when a piece is not a
+// number or the count differs from `count` (any count when count < 0).
+std::vector<double> parseNumbers(const std::string& option, const std::string& text, int count);
+
+// An integer in [lo, hi] or argsError naming `option`.
+long parseInteger(const std::string& option, const std::string& text, long lo, long hi);
+
+// A Tcl boolean (1, 0, on, off, yes, no, true, false) or argsError.
+bool parseBoolean(const std::string& option, const std::string& text);
+
+}  // namespace pvr::tcl
