@@ -14,7 +14,7 @@ namespace kernel {
 // the ray reached the early-termination opacity.
 template <typename T, bool kShaded, bool kPreintegrated>
 inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t start,
-                      std::int64_t exit, Rgba& acc, std::uint64_t& samples) {
+                      std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
   const T* v = static_cast<const T*>(p.voxels);
   const float o0 = float(ray.origin[0]), o1 = float(ray.origin[1]), o2 = float(ray.origin[2]);
   const float d0 = float(ray.step[0]), d1 = float(ray.step[1]), d2 = float(ray.step[2]);
@@ -37,16 +37,78 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
       if (!(c.a > 0)) continue;
       c = shade(v, p, ray, x0, x1, x2, c);
     }
-    const float t = 1.0f - acc.a;
-    acc.r += t * c.r;
-    acc.g += t * c.g;
-    acc.b += t * c.b;
-    acc.a += t * c.a;
+    acc.addBehind(c);
     if (acc.a >= p.earlyTermination) return true;
   }
   return false;
 }
 
+// One sample standing for the segment [from, to] of the ray (in steps),
+// composited into acc: classified at `at` (plain) or pre-integrated from
+// `from` to `to`, shaded at `at`, then stretched from one step to the
+// segment's length. `at` is a sample this brick owns (or a short chord's
+// midpoint), and `from` and `to` lie within a step of it, so every read
+// stays within the ghost layers. Returns true at early termination.
+// Out of line and cold: it runs at most twice per ray.
+template <typename T, bool kShaded, bool kPreintegrated>
+[[gnu::noinline, gnu::cold]] bool runSegment(const KernelParams& p, const RaySetup& ray,
+                                             double at, double from, double to,
+                                             Accumulator& acc, std::uint64_t& samples) {
+  const T* v = static_cast<const T*>(p.voxels);
+  auto position = [&](double k, float* x) {
+    for (int a = 0; a < 3; ++a) x[a] = float(ray.origin[a] + k * ray.step[a]);
+  };
+  float x[3];
+  position(at, x);
+  Rgba c;
+  if constexpr (kPreintegrated) {
+    float f[3], b[3];
+    position(from, f);
+    position(to, b);
+    const float front = around(v, p, f[0], f[1], f[2]), back = around(v, p, b[0], b[1], b[2]);
+    if (finite<T>(front) && finite<T>(back)) c = classify2D(p, front, back);
+  } else {
+    const float value = trilinear(v, p, x[0], x[1], x[2], p.ownCellLo, p.ownCellHi);
+    if (finite<T>(value)) c = classify1D(p, value);
+  }
+  ++samples;
+  if constexpr (kShaded) {
+    if (c.a > 0) c = shade(v, p, ray, x[0], x[1], x[2], c);
+  }
+  acc.addBehind(stretch(c, to - from));
+  return acc.a >= p.earlyTermination;
+}
+
+// Sample s at an end of the chord (see ChordEnds): its segment stretched or
+// cut to the chord.
+template <typename T, bool kShaded, bool kPreintegrated>
+inline bool runEnd(const KernelParams& p, const RaySetup& ray, const ChordEnds& ends,
+                   std::int64_t s, Accumulator& acc, std::uint64_t& samples) {
+  // Plain: the half steps around s; pre-integrated: s to s + 1.
+  const double before = kPreintegrated ? 0.0 : 0.5, after = kPreintegrated ? 1.0 : 0.5;
+  const double from = double(s) - (s == ends.first ? ends.head : before);
+  const double to = double(s) + (s == ends.last ? ends.tail : after);
+  return runSegment<T, kShaded, kPreintegrated>(p, ray, double(s), from, to, acc, samples);
+}
+
+// Samples [start, exit) of a visible run: the chord's end samples by
+// runEnd, the others in one loop. Returns true at early termination.
+template <typename T, bool kShaded, bool kPreintegrated>
+inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds& ends,
+                    std::int64_t start, std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
+  if (start == ends.first && start < exit) {
+    if (runEnd<T, kShaded, kPreintegrated>(p, ray, ends, start, acc, samples)) return true;
+    ++start;
+  }
+  const std::int64_t body = std::min(exit, ends.last);
+  if (start < body) {
+    if (runScalar<T, kShaded, kPreintegrated>(p, ray, start, body, acc, samples)) return true;
+    start = body;
+  }
+  if (start == ends.last && start < exit)
+    return runEnd<T, kShaded, kPreintegrated>(p, ray, ends, start, acc, samples);
+  return false;
+}
 
 }  // namespace kernel
 
@@ -54,12 +116,29 @@ template <typename T, bool kShaded, bool kPreintegrated>
 RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
   RayResult out;
   std::int64_t first, last;
-  if (!kernel::sampleRange(p, ray, first, last)) return out;
+  if (!kernel::sampleRange(p, ray, first, last)) {
+    // No sample here; the ray may still cross the domain between two samples.
+    double kIn, kOut;
+    if (kernel::shortChord(p, ray, kIn, kOut)) {
+      const double mid = 0.5 * (kIn + kOut);
+      int m[3];
+      for (int a = 0; a < 3; ++a)
+        m[a] = std::clamp(int(ray.origin[a] + mid * ray.step[a]) >> mcShift, p.mcFirst[a],
+                          p.mcFirst[a] + p.mcCount[a] - 1);
+      out.hit = true;
+      kernel::Accumulator acc;
+      if (p.visible[kernel::macrocellIndex(p, m)])
+        kernel::runSegment<T, kShaded, kPreintegrated>(p, ray, mid, kIn, kOut, acc, out.samples);
+      out.colour = acc.rgba();
+    }
+    return out;
+  }
   out.hit = true;
+  const kernel::ChordEnds ends = kernel::chordEnds(p, ray, first, last);
 
   const float o0 = float(ray.origin[0]), o1 = float(ray.origin[1]), o2 = float(ray.origin[2]);
   const float d0 = float(ray.step[0]), d1 = float(ray.step[1]), d2 = float(ray.step[2]);
-  Rgba acc;
+  kernel::Accumulator acc;
   std::int64_t done = first;  // next sample not yet composited or skipped
   std::int64_t k = first;
   while (k <= last) {
@@ -79,11 +158,12 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
     // sample before this run was skipped, its segment ends in here.
     std::int64_t start = k;
     if constexpr (kPreintegrated) start = (done < k) ? std::max(first, k - 1) : k;
-    if (kernel::runScalar<T, kShaded, kPreintegrated>(p, ray, start, exit, acc, out.samples)) break;
+    if (kernel::runSpan<T, kShaded, kPreintegrated>(p, ray, ends, start, exit, acc, out.samples))
+      break;
     done = exit;
     k = exit;
   }
-  out.colour = acc;
+  out.colour = acc.rgba();
   return out;
 }
 

@@ -4,7 +4,10 @@
 // screen rectangle its owned box projects to. Samples lie at t = k * h along
 // each camera ray, the same for every brick, and a sample belongs to exactly
 // one brick (owned boxes are half-open where bricks meet), so bricks
-// rendered apart and composited front to back equal the whole.
+// rendered apart and composited front to back equal the whole. Each sample
+// stands for one step of the ray; the first and last samples of the ray's
+// chord through the domain stand for the stretch to the domain's faces, so
+// the samples cover the chord exactly (kernel.h, ChordEnds).
 #pragma once
 
 #include <cstdint>
