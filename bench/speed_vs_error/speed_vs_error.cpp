@@ -1,0 +1,286 @@
+// speed_vs_error: what each rendering setting costs and what it buys.
+//
+//   speed_vs_error [options] [SCENE.json ...]
+//       For each scene (default: the phantom, the peer scene and one scene per
+//       real volume; a scene whose volume file is missing is skipped with a
+//       message) sweeps step {2, 1, 0.5, 0.25, 0.125} voxels x {plain,
+//       pre-integrated} x {skipping on, off}, plus the scene's own settings
+//       when they are not among them. Per case: median time per frame, samples
+//       per second (total and per thread) and RMSE / PSNR / max abs error of
+//       linear premultiplied RGBA against the scene's reference. Prints a
+//       table and writes CSV.
+//   speed_vs_error --quick SCENE.json [--orbit K]
+//       The scene at its own settings only, the same figures, for scripts/demo.
+//       --orbit K times K frames turning the camera 5 degrees each about its
+//       view-up, the camera path of the VTK peer benchmark.
+//
+// Options: --threads N (2), --frames N (5), --error-size N (256: longer side of
+// the reference and of the images compared with it), --substeps N (64: the
+// reference's dt is the smallest spacing / N, at most the scene step / 16),
+// --steps LIST (voxels, comma-separated), --case-seconds S (sweep: stop timing
+// a case once its frames add up to S seconds, after at least one; the CSV
+// says how many frames each median has), --csv PATH, --cache DIR, --no-cache.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "error.h"
+#include "measure.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace pvr;
+using bench::BenchScene;
+using bench::Case;
+using bench::CaseResult;
+using bench::Reference;
+
+constexpr double kOrbitDegrees = 5;  // peer_common.ROTATE_DEG_PER_FRAME
+
+// The sweep's scenes, relative to the source tree.
+const char* const kDefaultScenes[] = {
+    "examples/scenes/default.json",        "bench/scenes/peer_blobs.json",
+    "examples/scenes/ct_head_bone.json",   "examples/scenes/mri_head.json",
+    "examples/scenes/mri_brain_pd.json",   "examples/scenes/orbital_oxirane.json",
+    "examples/scenes/water_density.json",
+};
+
+struct Args {
+  std::string quick;
+  std::vector<std::string> scenes;
+  std::vector<double> steps{2, 1, 0.5, 0.25, 0.125};
+  int threads = 2, frames = 5, orbit = 0;
+  double caseSeconds = 0;  // sweep: stop timing a case after this long (0 = never)
+  bench::ReferenceSettings reference{256, 64, 16, PVR_BENCH_CACHE};
+  std::string csv = std::string(PVR_SOURCE_DIR) + "/bench/results/speed_vs_error.csv";
+};
+
+[[noreturn]] void usage(const std::string& why) {
+  std::fprintf(stderr,
+               "speed_vs_error: %s\n"
+               "usage: speed_vs_error [--threads N] [--frames N] [--error-size N] [--substeps N]\n"
+               "                      [--steps A,B,...] [--case-seconds S] [--csv PATH]\n"
+               "                      [--cache DIR | --no-cache] [SCENE.json ...]\n"
+               "       speed_vs_error --quick SCENE.json [--orbit K] [same options]\n",
+               why.c_str());
+  std::exit(2);
+}
+
+std::vector<double> parseList(const std::string& text) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    const double v = std::stod(item);
+    if (!(v > 0)) usage("--steps: every step must be > 0");
+    out.push_back(v);
+  }
+  if (out.empty()) usage("--steps: no steps");
+  return out;
+}
+
+Args parseArgs(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage(arg + " needs a value");
+      return argv[++i];
+    };
+    auto positive = [&](const std::string& v) {
+      const int n = std::stoi(v);
+      if (n < 1) usage(arg + " must be >= 1");
+      return n;
+    };
+    try {
+      if (arg == "--quick") a.quick = value();
+      else if (arg == "--threads") a.threads = positive(value());
+      else if (arg == "--frames") a.frames = positive(value());
+      else if (arg == "--orbit") a.orbit = positive(value());
+      else if (arg == "--case-seconds") a.caseSeconds = std::stod(value());
+      else if (arg == "--error-size") a.reference.maxEdge = positive(value());
+      else if (arg == "--substeps") a.reference.substeps = positive(value());
+      else if (arg == "--steps") a.steps = parseList(value());
+      else if (arg == "--csv") a.csv = value();
+      else if (arg == "--cache") a.reference.cacheDir = value();
+      else if (arg == "--no-cache") a.reference.cacheDir.clear();
+      else if (!arg.empty() && arg[0] == '-') usage("unknown option " + arg);
+      else a.scenes.push_back(arg);
+    } catch (const std::logic_error&) {
+      usage(arg + ": not a number");
+    }
+  }
+  if (!a.quick.empty() && !a.scenes.empty()) usage("--quick takes one scene; no other scene files");
+  if (a.quick.empty() && a.orbit > 0) usage("--orbit goes with --quick");
+  if (a.scenes.empty())
+    for (const char* s : kDefaultScenes) a.scenes.push_back(std::string(PVR_SOURCE_DIR) + "/" + s);
+  return a;
+}
+
+std::string shortName(const std::string& scenePath) { return fs::path(scenePath).stem().string(); }
+
+const char* onOff(bool b) { return b ? "on" : "off"; }
+
+// A text field for the CSV without quoting: gnuplot and awk split on every comma.
+std::string csvField(std::string text) {
+  for (char& ch : text)
+    if (ch == ',' || ch == '"') ch = ';';
+  return text;
+}
+
+void printReference(const Reference& ref, const BenchScene& scene) {
+  std::printf("  reference: %dx%d, dt %.4g voxel, double precision, %s %.1f s; "
+              "self-check dt vs dt/2: max abs %.1e, RMSE %.1e\n",
+              ref.size.width, ref.size.height, ref.dt / scene.voxel(),
+              ref.fromCache ? "from cache, took" : "took", ref.seconds, ref.selfCheckMaxAbs,
+              ref.selfCheckRmse);
+}
+
+int runQuick(const Args& args) {
+  if (auto missing = bench::missingVolume(args.quick)) {
+    std::printf("%s: skipped, %s\n", args.quick.c_str(), missing->c_str());
+    return 0;
+  }
+  core::ThreadPool pool(args.threads);
+  const BenchScene scene(args.quick);
+  const core::Scene& s = scene.scene();
+  const Case c = bench::ownCase(s);
+  std::printf("%s: %s, %dx%d, step %.3g voxel, %s, skipping on, %s, %d threads\n",
+              args.quick.c_str(), scene.describe().c_str(), s.image.width, s.image.height,
+              c.step / scene.voxel(), c.preintegrated ? "pre-integrated" : "plain",
+              s.shading.enabled ? "shaded" : "unshaded", pool.size());
+  const Reference ref = bench::computeReference(scene, args.reference, pool);
+  printReference(ref, scene);
+  const double orbit = args.orbit > 0 ? kOrbitDegrees : 0;
+  const int frames = args.orbit > 0 ? args.orbit : args.frames;
+  const CaseResult r = bench::measureCase(scene, c, ref, frames, 0, orbit, pool);
+  const bench::Timing& t = r.timing;
+  std::printf("  time per frame     %.4f s (median of %d%s; min %.4f, max %.4f; load %.2f)\n",
+              t.median, t.frames, args.orbit > 0 ? ", turning 5 degrees per frame" : "", t.min,
+              t.max, r.load1);
+  std::printf("  samples per second %.1f M total, %.1f M per core (%d threads)\n",
+              t.samplesPerSecond() * 1e-6, t.samplesPerSecond() * 1e-6 / pool.size(), pool.size());
+  std::printf("  error vs reference RMSE %.3e, PSNR %.2f dB, max abs %.3e (linear RGBA at %dx%d)\n",
+              r.error.rmse, r.error.psnr, r.error.maxAbs, ref.size.width, ref.size.height);
+  return 0;
+}
+
+// The sweep's cases for a scene: the grid of settings, and the scene's own
+// settings (flagged; added when the grid lacks them).
+struct SweepCase {
+  Case c;
+  bool own = false;
+};
+std::vector<SweepCase> sweepCases(const Args& args, const BenchScene& scene) {
+  const Case own = bench::ownCase(scene.scene());
+  std::vector<SweepCase> cases;
+  bool ownFound = false;
+  for (double steps : args.steps)
+    for (bool pre : {false, true})
+      for (bool skip : {true, false}) {
+        const Case c{steps * scene.voxel(), pre, skip};
+        const bool isOwn = std::abs(c.step - own.step) <= 1e-6 * own.step &&
+                           pre == own.preintegrated && skip == own.skipEmpty;
+        ownFound |= isOwn;
+        cases.push_back({c, isOwn});
+      }
+  if (!ownFound) cases.push_back({own, true});
+  return cases;
+}
+
+class CsvWriter {
+ public:
+  CsvWriter(const std::string& path, const Args& args) : out_(path) {
+    if (!out_) throw Error(ErrorCode::kIo, path + ": cannot write");
+    const std::time_t now = std::time(nullptr);
+    char when[64];
+    std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S", std::localtime(&now));
+    out_ << "# speed_vs_error " << when << ", " << args.threads << " threads, median of "
+         << args.frames << " frames (fewer where a case's frames passed --case-seconds "
+         << args.caseSeconds << "; see frames); error against a double-precision reference at "
+         << "--error-size " << args.reference.maxEdge
+         << "; load1 = 1-minute load average at the start of the case\n";
+    out_ << "scene,volume,shaded,step_voxels,step_world,preintegrated,skipping,scene_default,"
+            "threads,width,height,frames,median_s,min_s,max_s,samples_per_frame,msamples_per_s,"
+            "msamples_per_s_per_core,error_width,error_height,rmse,psnr_db,max_abs,"
+            "reference_dt_voxels,load1\n";
+  }
+  void row(const BenchScene& scene, const SweepCase& sc, const CaseResult& r, const Reference& ref,
+           int threads) {
+    const core::Scene& s = scene.scene();
+    const bench::Timing& t = r.timing;
+    char line[1024];
+    std::snprintf(line, sizeof line,
+                  "%s,%s,%d,%.6g,%.6g,%d,%d,%d,%d,%d,%d,%d,%.6f,%.6f,%.6f,%.0f,%.3f,%.3f,%d,%d,"
+                  "%.6e,%.3f,%.6e,%.6g,%.2f\n",
+                  csvField(shortName(scene.path())).c_str(), csvField(scene.describe()).c_str(),
+                  int(s.shading.enabled), sc.c.step / scene.voxel(), sc.c.step,
+                  int(sc.c.preintegrated), int(sc.c.skipEmpty),
+                  int(sc.own), threads, s.image.width, s.image.height, t.frames, t.median, t.min,
+                  t.max, t.frames > 0 ? double(t.samples) / t.frames : 0.0,
+                  t.samplesPerSecond() * 1e-6, t.samplesPerSecond() * 1e-6 / threads,
+                  ref.size.width, ref.size.height, r.error.rmse, r.error.psnr, r.error.maxAbs,
+                  ref.dt / scene.voxel(), r.load1);
+    out_ << line;
+    out_.flush();
+  }
+
+ private:
+  std::ofstream out_;
+};
+
+int runSweep(const Args& args) {
+  core::ThreadPool pool(args.threads);
+  fs::create_directories(fs::path(args.csv).parent_path());
+  CsvWriter csv(args.csv, args);
+  for (const std::string& path : args.scenes) {
+    if (auto missing = bench::missingVolume(path)) {
+      std::printf("\n%s: skipped, %s\n", path.c_str(), missing->c_str());
+      continue;
+    }
+    const BenchScene scene(path);
+    const core::Scene& s = scene.scene();
+    std::printf("\n%s: %s, %dx%d, %s, %d threads\n", shortName(path).c_str(),
+                scene.describe().c_str(), s.image.width, s.image.height,
+                s.shading.enabled ? "shaded" : "unshaded", pool.size());
+    std::fflush(stdout);
+    const Reference ref = bench::computeReference(scene, args.reference, pool);
+    printReference(ref, scene);
+    std::printf("  %-6s %-8s %-4s %9s %9s %9s %10s %8s %9s %5s\n", "step", "classify", "skip",
+                "s/frame", "Msamp/s", "per core", "RMSE", "PSNR dB", "max abs", "load");
+    for (const SweepCase& sc : sweepCases(args, scene)) {
+      const CaseResult r =
+          bench::measureCase(scene, sc.c, ref, args.frames, args.caseSeconds, 0, pool);
+      const double rate = r.timing.samplesPerSecond() * 1e-6;
+      std::printf("  %-6.4g %-8s %-4s %9.4f %9.1f %9.1f %10.3e %8.2f %9.2e %5.2f%s\n",
+                  sc.c.step / scene.voxel(), sc.c.preintegrated ? "preint" : "plain",
+                  onOff(sc.c.skipEmpty), r.timing.median, rate, rate / pool.size(), r.error.rmse,
+                  r.error.psnr, r.error.maxAbs, r.load1, sc.own ? "  <- scene's own settings" : "");
+      std::fflush(stdout);
+      csv.row(scene, sc, r, ref, pool.size());
+    }
+  }
+  std::printf("\nwrote %s\n", args.csv.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parseArgs(argc, argv);
+  try {
+    return args.quick.empty() ? runSweep(args) : runQuick(args);
+  } catch (const pvr::Error& e) {
+    std::fprintf(stderr, "speed_vs_error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "speed_vs_error: %s\n", e.what());
+    return 1;
+  }
+}
