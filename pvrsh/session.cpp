@@ -265,7 +265,17 @@ void Session::onMessage(const proto::Decoded& d) {
   try {
     if (id == 0) {
       // About the connection itself: an Error, or Close.
-      if (const auto* e = std::get_if<proto::ErrorMessage>(&d.message)) report(remoteError(*e));
+      // An Error here fails whatever waits (open's handshake); an open
+      // session reports it.
+      if (const auto* e = std::get_if<proto::ErrorMessage>(&d.message)) {
+        lastFailure_ = remoteError(*e);
+        for (auto& [pid, p] : pending_)
+          if (p.synchronous && !p.done) {
+            p.error = lastFailure_;
+            p.done = true;
+          }
+        if (state_ == State::kOpen) report(*lastFailure_);
+      }
       if (const auto* c = std::get_if<proto::Close>(&d.message)) closeReason_ = c->reason;
     } else if (dropped_.count(id)) {
       if (d.info.final() || std::holds_alternative<proto::ErrorMessage>(d.message)) dropped_.erase(id);
@@ -309,16 +319,17 @@ void Session::onMessage(const proto::Decoded& d) {
 void Session::onFailure(const TclError& error) {
   if (deleted_) return;
   Tcl_Preserve(this);
-  TclError e = error;
+  TclError e = lastFailure_ && lastFailure_->code().size() > 1 && lastFailure_->code()[1] == "REMOTE" ? *lastFailure_ : error;
   if (!closeReason_.empty() && e.code().size() > 2 && e.code()[2] == "LOST")
     e = TclError(e.code(), e.what() + std::string(" (") + closeReason_ + ")");
   const bool wasOpen = state_ == State::kOpen;
   state_ = State::kFailed;
   lastFailure_ = e;
-  for (auto& [id, p] : pending_) {
-    p.error = e;
-    p.done = true;
-  }
+  for (auto& [id, p] : pending_)
+    if (!p.done) {
+      p.error = e;
+      p.done = true;
+    }
   for (auto it = pending_.begin(); it != pending_.end();)
     it = it->second.synchronous ? std::next(it) : pending_.erase(it);
   const bool hadSequences = !sequences_.empty();
