@@ -33,9 +33,9 @@ void onSignal(int sig) {
 std::string nodeNextToSelf() {
   char buf[PATH_MAX];
   const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) return "pvr-node-server";
+  if (n <= 0) return "pvr-node";
   std::string self(buf, std::size_t(n));
-  return self.substr(0, self.rfind('/') + 1) + "pvr-node-server";
+  return self.substr(0, self.rfind('/') + 1) + "pvr-node";
 }
 
 void refuse(int fd, pvr::proto::ErrorCode code, const std::string& text) {

@@ -148,6 +148,14 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
     int m[3] = {std::clamp(int(u0) >> mcShift, p.mcFirst[0], p.mcFirst[0] + p.mcCount[0] - 1),
                 std::clamp(int(u1) >> mcShift, p.mcFirst[1], p.mcFirst[1] + p.mcCount[1] - 1),
                 std::clamp(int(u2) >> mcShift, p.mcFirst[2], p.mcFirst[2] + p.mcCount[2] - 1)};
+    // Deep in empty space: leap over the macrocells the distance field
+    // proves empty (those within d - 1 of this one, whatever the position
+    // of sample k inside it), then look again.
+    const int distance = p.distance[kernel::macrocellIndex(p, m)];
+    if (distance > 1) {
+      k += std::max<std::int64_t>(1, std::int64_t(double(distance - 1) * ray.leapPerMacrocell));
+      continue;
+    }
     bool visible;
     const std::int64_t exit = kernel::runExit(p, ray, m, k, last, mcShift, visible);
     if (!visible) {

@@ -32,6 +32,7 @@ struct KernelParams {
   float invSpacing[3];  // 1 / spacing, for world-space gradients
   // Macrocells.
   const std::uint8_t* visible = nullptr;
+  const std::uint8_t* distance = nullptr;  // MacrocellGrid::distance()
   int mcFirst[3], mcCount[3];
   // Classification.
   const Rgba* table = nullptr;  // TransferTable or PreintegratedTable entries
@@ -47,6 +48,7 @@ struct RaySetup {
   double origin[3];
   double step[3];
   double invStep[3];  // 1 / step (0 where step is 0): macrocell exits without division
+  double leapPerMacrocell;  // samples per macrocell edge along the ray's major axis
   float light[3];     // unit vector towards the light, world space
   float halfway[3];   // Blinn-Phong half vector, world space
 };
@@ -293,38 +295,51 @@ inline std::size_t macrocellIndex(const KernelParams& p, const int* m) {
 // `m` is the macrocell of sample k; *visible tells whether it was visible.
 // Walking macrocell to macrocell (a 3D DDA) until the visibility changes
 // turns a long visible stretch into one uninterrupted sample loop.
-inline std::int64_t runExit(const KernelParams& p, const RaySetup& r, int m[3], std::int64_t k,
+inline std::int64_t runExit(const KernelParams& p, const RaySetup& r, const int m[3], std::int64_t k,
                             std::int64_t last, int shift, bool& visible) {
-  visible = p.visible[macrocellIndex(p, m)];
-  // Sample index at which the ray crosses the next macrocell face on each axis.
-  double next[3];
-  double delta[3];
-  int stepDir[3];
+  std::int64_t index = std::int64_t(macrocellIndex(p, m));
+  visible = p.visible[index];
+  // Per axis: the sample index at which the ray crosses the next macrocell
+  // face, its increment per macrocell, the step through p.visible, and how
+  // many macrocells remain before the brick's edge.
+  const std::int64_t stride[3] = {1, p.mcCount[0], std::int64_t(p.mcCount[0]) * p.mcCount[1]};
+  double next[3], delta[3];
+  std::int64_t move[3];
+  int remaining[3];
   for (int a = 0; a < 3; ++a) {
+    const double cellEdge = double(std::int64_t(1) << shift);
     if (r.step[a] > 0) {
-      stepDir[a] = 1;
       next[a] = (double(std::int64_t(m[a] + 1) << shift) - r.origin[a]) * r.invStep[a];
-      delta[a] = double(1 << shift) * r.invStep[a];
+      delta[a] = cellEdge * r.invStep[a];
+      move[a] = stride[a];
+      remaining[a] = p.mcFirst[a] + p.mcCount[a] - 1 - m[a];
     } else if (r.step[a] < 0) {
-      stepDir[a] = -1;
       next[a] = (double(std::int64_t(m[a]) << shift) - r.origin[a]) * r.invStep[a];
-      delta[a] = -double(1 << shift) * r.invStep[a];
+      delta[a] = -cellEdge * r.invStep[a];
+      move[a] = -stride[a];
+      remaining[a] = m[a] - p.mcFirst[a];
     } else {
-      stepDir[a] = 0;
-      next[a] = 1e18;
+      next[a] = 1e300;
       delta[a] = 0;
+      move[a] = 0;
+      remaining[a] = 0;
     }
   }
+  // ceil(x) > last exactly when x > last, for the integer last: the exit
+  // sample is only rounded once, on the way out.
+  const double lastK = double(last);
+  const std::uint8_t want = visible;
   for (;;) {
     const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
-    const double exitK = next[a];
-    const std::int64_t exit = std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(exitK)));
-    if (exit > last) return last + 1;
-    m[a] += stepDir[a];
-    if (m[a] < p.mcFirst[a] || m[a] >= p.mcFirst[a] + p.mcCount[a]) return exit;
-    if (bool(p.visible[macrocellIndex(p, m)]) != visible) return exit;
+    if (next[a] > lastK) return last + 1;
+    if (remaining[a] == 0) break;
+    --remaining[a];
+    index += move[a];
+    if (p.visible[index] != want) break;
     next[a] += delta[a];
   }
+  const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+  return std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(next[a])));
 }
 
 }  // namespace kernel

@@ -62,6 +62,38 @@ MacrocellGrid::MacrocellGrid(const Brick& brick) {
 void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty) {
   for (std::size_t i = 0; i < visible_.size(); ++i)
     visible_[i] = !skipEmpty || (min_[i] <= max_[i] && table.anyVisible(min_[i], max_[i]));
+  updateDistances();
+}
+
+void MacrocellGrid::updateDistances() {
+  // Two raster passes of a chamfer transform with the 26-neighbourhood give
+  // the exact chessboard distance: forward with the neighbours already
+  // visited, backward with the others.
+  const int nx = int(count_.x), ny = int(count_.y), nz = int(count_.z);
+  distance_.assign(visible_.size(), 255);
+  auto at = [&](int x, int y, int z) -> std::uint8_t& {
+    return distance_[(std::size_t(z) * ny + y) * nx + x];
+  };
+  for (std::size_t i = 0; i < visible_.size(); ++i)
+    if (visible_[i]) distance_[i] = 0;
+  auto relax = [&](int x, int y, int z, int dirSign) {
+    std::uint8_t& d = at(x, y, z);
+    for (int dz = -1; dz <= 0; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          // Neighbours earlier in this pass's raster order.
+          if (dz == 0 && (dy > 0 || (dy == 0 && dx >= 0))) continue;
+          const int qx = x + dirSign * dx, qy = y + dirSign * dy, qz = z + dirSign * dz;
+          if (qx < 0 || qy < 0 || qz < 0 || qx >= nx || qy >= ny || qz >= nz) continue;
+          d = std::uint8_t(std::min<int>(d, at(qx, qy, qz) + 1));
+        }
+  };
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) relax(x, y, z, 1);
+  for (int z = nz - 1; z >= 0; --z)
+    for (int y = ny - 1; y >= 0; --y)
+      for (int x = nx - 1; x >= 0; --x) relax(x, y, z, -1);
 }
 
 std::size_t MacrocellGrid::visibleCount() const {

@@ -36,12 +36,20 @@ class MacrocellGrid {
   IVec3 first() const { return first_; }    // global index of the brick's first macrocell
   IVec3 count() const { return count_; }    // macrocells per axis
   const std::uint8_t* visible() const { return visible_.data(); }
+  // Chessboard distance, in macrocells, from each macrocell to the nearest
+  // visible one (0 for visible macrocells, capped at 255). A ray in a
+  // macrocell at distance d may leap d - 1 macrocells along its major axis
+  // without meeting anything visible (space leaping with a distance field).
+  const std::uint8_t* distance() const { return distance_.data(); }
   std::size_t visibleCount() const;
 
  private:
   IVec3 first_, count_;
   std::vector<float> min_, max_;
   std::vector<std::uint8_t> visible_;
+  std::vector<std::uint8_t> distance_;
+
+  void updateDistances();
 };
 
 }  // namespace pvr::core

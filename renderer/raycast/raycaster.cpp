@@ -101,6 +101,7 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
     p.mcCount[a] = int(macrocells_.count()[a]);
   }
   p.visible = macrocells_.visible();
+  p.distance = macrocells_.distance();
   if (preintegrated_) {
     p.table = preintegrated_->entries();
     p.tableEntries = PreintegratedTable::kEntries;
@@ -139,6 +140,8 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
           s.step[a] = ray.direction[a] * options.step / grid.spacing[a];
           s.invStep[a] = s.step[a] != 0 ? 1.0 / s.step[a] : 0.0;
         }
+        const double major = std::max({std::abs(s.step[0]), std::abs(s.step[1]), std::abs(s.step[2])});
+        s.leapPerMacrocell = double(MacrocellGrid::kSize) / major;
         // Headlight by default: the light direction is fixed in camera space.
         // The viewer looks back along the ray.
         const Vec3 view = -ray.direction;

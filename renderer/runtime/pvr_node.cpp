@@ -1,5 +1,9 @@
-// pvr-node: the MPI program. Batch mode renders one scene across the ranks
-// and writes the frame:
+// pvr-node: the MPI program. Server mode is the job a pvrd session runs
+// (server_mode.h, docs/runtime.md):
+//
+//   mpirun -np N pvr-node --server --connect HOST:PORT --data-dir DIR
+//
+// Batch mode renders one scene across the ranks and writes the frame:
 //
 //   mpirun -np N pvr-node --batch SCENE.json -o OUT.exr|OUT.png
 //          [--strategy binary-swap|direct-send|tree|radix-k] [--radix K]
@@ -18,6 +22,7 @@
 #include "image_io.h"
 #include "mpi_communicator.h"
 #include "report.h"
+#include "server_mode.h"
 
 namespace {
 
@@ -30,7 +35,8 @@ struct Args {
 };
 
 constexpr const char* kUsage =
-    "usage: mpirun -np N pvr-node --batch SCENE.json -o OUT.exr|OUT.png [--strategy NAME] [--radix K]\n"
+    "usage: mpirun -np N pvr-node --server --connect HOST:PORT --data-dir DIR\n"
+    "       mpirun -np N pvr-node --batch SCENE.json -o OUT.exr|OUT.png [--strategy NAME] [--radix K]\n"
     "       [--decomposition kd|balanced] [--early-termination A] [--threads N]\n"
     "       [--codec auto|rle|rle-zlib|raw] [--size WxH] [--stats FILE.csv]\n";
 
@@ -125,6 +131,16 @@ int run(const Args& args, composite::Communicator& comm) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) != "--server") continue;
+    runtime::ServerOptions options;
+    std::string error;
+    if (!runtime::parseServerOptions(argc, argv, options, error)) {
+      std::fprintf(stderr, "pvr-node: %s\n", error.c_str());
+      return 2;
+    }
+    return runtime::runServer(options);
+  }
   composite::MpiEnvironment mpi(&argc, &argv);
   composite::Communicator& comm = mpi.world();
   try {

@@ -1,50 +1,39 @@
 #include "server_mode.h"
 
 #include <arpa/inet.h>
-#include <mpi.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
-#include <zlib.h>
 
-#include <chrono>
 #include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <memory>
-#include <nlohmann/json.hpp>
+#include <deque>
 
-#include "camera.h"
-#include "error.h"
-#include "image_io.h"
+#include "dispatch.h"
+#include "mpi_communicator.h"
+#include "node.h"
 #include "pvr_protocol.h"
-#include "raycast/raycaster.h"
-#include "scene.h"
-#include "scene_volume.h"
-#include "thread_pool.h"
+#include "wave_io.h"
 
 namespace pvr::runtime {
 namespace {
 
 using proto::ErrorCode;
-using Clock = std::chrono::steady_clock;
 
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-ErrorCode wireCode(const std::exception& e) {
-  if (const auto* pe = dynamic_cast<const pvr::Error*>(&e)) {
-    switch (pe->code()) {
-      case pvr::ErrorCode::kInvalidArgument: return ErrorCode::kBadArgument;
-      case pvr::ErrorCode::kBadFile: return ErrorCode::kBadFile;
-      case pvr::ErrorCode::kIo: return ErrorCode::kIo;
-      case pvr::ErrorCode::kUnsupported: return ErrorCode::kUnsupported;
-      case pvr::ErrorCode::kRemote: return ErrorCode::kRankFailed;
-      case pvr::ErrorCode::kInternal: return ErrorCode::kInternal;
-    }
+ErrorCode wireCode(pvr::ErrorCode code) {
+  switch (code) {
+    case pvr::ErrorCode::kInvalidArgument: return ErrorCode::kBadArgument;
+    case pvr::ErrorCode::kBadFile: return ErrorCode::kBadFile;
+    case pvr::ErrorCode::kIo: return ErrorCode::kIo;
+    case pvr::ErrorCode::kUnsupported: return ErrorCode::kUnsupported;
+    case pvr::ErrorCode::kRemote: return ErrorCode::kRankFailed;
+    case pvr::ErrorCode::kInternal: return ErrorCode::kInternal;
   }
-  return ErrorCode::kBadArgument;
+  return ErrorCode::kInternal;
 }
 
 // v rotated by `angle` radians about unit axis k (Rodrigues).
@@ -56,101 +45,186 @@ core::Vec3 rotate(const core::Vec3& v, const core::Vec3& k, double angle) {
           v.z * c + cross.z * s + k.z * dot * (1 - c)};
 }
 
+nlohmann::json clustersJson(const std::vector<proto::ClusterSpec>& specs) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& c : specs) out.push_back({int(c.role), c.ranks, c.group});
+  return out;
+}
+
 class Master {
  public:
-  Master(const ServerOptions& o, int fd) : opt_(o), fd_(fd) {
-    char buf[PATH_MAX];
-    if (::realpath(o.dataDir.c_str(), buf)) root_ = buf;
-  }
+  Master(NodeState& state, int fd) : state_(state), fd_(fd) {}
   void serve();
 
  private:
-  void send(const proto::Message& m, std::uint32_t id, bool final = true) {
-    const auto bytes = proto::encode(m, id, final ? proto::kFlagFinal : 0);
-    std::size_t done = 0;
-    while (done < bytes.size()) {
-      const ssize_t n = ::send(fd_, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
-      if (n <= 0) {
-        if (n < 0 && errno == EINTR) continue;
-        open_ = false;
-        return;
-      }
-      done += std::size_t(n);
-    }
+  void send(const proto::Message& m, std::uint32_t id, bool final = true);
+  void replyFailure(const RankFailure& f, std::uint32_t id) {
+    send(proto::ErrorMessage{wireCode(f.code), f.describe()}, id);
   }
+  std::optional<proto::Decoded> next(bool wait);
   void handle(const proto::Decoded& frame);
-  void setScene(const proto::SetScene& s);
-  core::Scene resolvedScene();
-  void renderOne(const core::Scene& scene, std::uint32_t frameNumber, std::uint32_t id, bool final);
+  bool handleAtOnce(const proto::Decoded& frame);  // Status/Performance/Cancel during a render
+  void layout(const std::vector<proto::ClusterSpec>& clusters, std::uint32_t id);
+  void setScene(const proto::SetScene& s, std::uint32_t id);
+  void performance(const proto::PerformanceRequest& p, std::uint32_t id);
+  void renderSequence(const std::vector<core::CameraSpec>& cameras, std::uint32_t id);
 
-  const ServerOptions& opt_;
+  NodeState& state_;
   int fd_;
   bool open_ = true;
-  std::string root_;
+  proto::FrameDecoder decoder_;
+  std::deque<proto::Decoded> pending_;
   nlohmann::json doc_ = nlohmann::json::object();
-  std::string volumePath_;
-  std::unique_ptr<core::VolumeSource> source_;
-  std::unique_ptr<core::Brick> brick_;
-  std::unique_ptr<core::BrickRenderer> renderer_;
-  core::ThreadPool pool_{0};
+  nlohmann::json runtime_ = nlohmann::json::object();
   std::uint32_t frames_ = 0;
+  std::uint32_t running_ = 0;   // request id of the render in progress
+  bool cancelled_ = false;
 };
 
-void Master::setScene(const proto::SetScene& s) {
+void Master::send(const proto::Message& m, std::uint32_t id, bool final) {
+  if (!open_) return;
+  const auto bytes = proto::encode(m, id, final ? proto::kFlagFinal : 0);
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::send(fd_, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      open_ = false;
+      return;
+    }
+    done += std::size_t(n);
+  }
+}
+
+// The next client message: queued first, then the socket (blocking or not).
+std::optional<proto::Decoded> Master::next(bool wait) {
+  for (;;) {
+    if (auto frame = decoder_.pop()) return frame;
+    if (decoder_.error()) {
+      send(proto::ErrorMessage{decoder_.error()->code, decoder_.error()->text}, 0);
+      open_ = false;
+      return std::nullopt;
+    }
+    if (!open_) return std::nullopt;
+    pollfd p{fd_, POLLIN, 0};
+    const int ready = ::poll(&p, 1, wait ? -1 : 0);
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready <= 0) return std::nullopt;
+    std::uint8_t buf[64 << 10];
+    const ssize_t n = ::read(fd_, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      open_ = false;
+      return std::nullopt;
+    }
+    decoder_.feed(std::span(buf, std::size_t(n)));
+  }
+}
+
+void Master::layout(const std::vector<proto::ClusterSpec>& clusters, std::uint32_t id) {
+  if (auto f = invoke(state_, "set_layout", {{"clusters", clustersJson(clusters)}})) return replyFailure(*f, id);
+  send(proto::SessionReady{std::uint32_t(state_.world.size()), state_.layout.specs()}, id);
+}
+
+void Master::setScene(const proto::SetScene& s, std::uint32_t id) {
   nlohmann::json doc = doc_;
-  if (!s.sceneJson.empty()) doc.merge_patch(nlohmann::json::parse(s.sceneJson));
-  std::string path = volumePath_;
+  nlohmann::json runtime = runtime_;
+  if (!s.sceneJson.empty()) {
+    nlohmann::json patch = nlohmann::json::parse(s.sceneJson, nullptr, false);
+    if (patch.is_discarded() || !patch.is_object())
+      return send(proto::ErrorMessage{ErrorCode::kBadArgument, "scene: not a JSON object"}, id);
+    if (patch.contains("runtime")) {
+      runtime.merge_patch(patch["runtime"]);
+      patch.erase("runtime");
+    }
+    // Files come only through the dataset name, which the handler resolved.
+    if (patch.contains("volume") && patch["volume"].is_object() && patch["volume"].contains("file"))
+      return send(proto::ErrorMessage{ErrorCode::kBadArgument, "scene: name a dataset, not a volume file"}, id);
+    doc.merge_patch(patch);
+  }
   if (!s.dataset.empty()) {
     char buf[PATH_MAX];
-    const std::string wanted = s.dataset[0] == '/' ? s.dataset : root_ + "/" + s.dataset;
-    const bool ok = ::realpath(wanted.c_str(), buf) && !root_.empty() &&
-                    std::strncmp(buf, root_.c_str(), root_.size()) == 0 && buf[root_.size()] == '/';
-    if (!ok) throw pvr::Error(pvr::ErrorCode::kInvalidArgument, "no dataset '" + s.dataset + "' in the data directory");
-    path = buf;
+    const std::string wanted = s.dataset[0] == '/' ? s.dataset : state_.dataDir + "/" + s.dataset;
+    const bool inside = ::realpath(wanted.c_str(), buf) && !state_.dataDir.empty() &&
+                        std::strncmp(buf, state_.dataDir.c_str(), state_.dataDir.size()) == 0 &&
+                        buf[state_.dataDir.size()] == '/';
+    if (!inside)
+      return send(proto::ErrorMessage{ErrorCode::kDatasetNotFound, "no dataset '" + s.dataset + "' in the data directory"}, id);
+    doc["volume"] = nlohmann::json{{"file", buf}};
   }
-  if (!path.empty()) doc["volume"] = nlohmann::json{{"file", path}};
-  if (doc.contains("volume")) core::parseScene(doc, root_);  // throws on a bad scene: the old one stays
-  if (path != volumePath_) {
-    auto source = core::openVolumeFile(path);
-    auto brick = std::make_unique<core::Brick>(source->readAll());
-    renderer_ = std::make_unique<core::BrickRenderer>(*brick);
-    brick_ = std::move(brick);
-    source_ = std::move(source);
-    volumePath_ = path;
+  if (!doc.contains("volume")) {  // nothing to render yet: keep the settings for later
+    doc_ = std::move(doc);
+    runtime_ = std::move(runtime);
+    return send(proto::Ok{}, id);
   }
+  const bool newVolume = !doc_.contains("volume") || doc_["volume"] != doc["volume"];
+  const auto failure = invoke(state_, newVolume ? "load_dataset" : "set_scene", {{"scene", doc}, {"runtime", runtime}});
+  if (failure) return replyFailure(*failure, id);
   doc_ = std::move(doc);
+  runtime_ = std::move(runtime);
+  send(proto::Ok{}, id);
 }
 
-core::Scene Master::resolvedScene() {
-  if (!source_) throw pvr::Error(pvr::ErrorCode::kInvalidArgument, "no dataset: send SetScene with a dataset first");
-  core::Scene scene = core::parseScene(doc_, root_);
-  core::resolveDefaults(scene, source_->grid());
-  return scene;
+void Master::performance(const proto::PerformanceRequest& p, std::uint32_t id) {
+  const int cluster = p.cluster == proto::kAllClusters ? -1 : int(p.cluster);
+  const char* action = p.query == proto::PerformanceQuery::kMemory ? "report_memory" : "comp_latency";
+  if (auto f = invoke(state_, action, {{"cluster", cluster}})) return replyFailure(*f, id);
+  send(proto::PerformanceReply{p.query, state_.reply.dump()}, id);
 }
 
-void Master::renderOne(const core::Scene& scene, std::uint32_t frameNumber, std::uint32_t id, bool final) {
-  proto::ImageFrame f;
-  f.frameNumber = frameNumber;
-  f.width = std::uint32_t(scene.image.width);
-  f.height = std::uint32_t(scene.image.height);
-  f.format = proto::PixelFormat::kRgba8;
-  f.compression = proto::Compression::kZlib;
-  auto t = Clock::now();
-  const core::RenderOptions options = core::renderOptionsFor(scene);
-  renderer_->classify(scene.transfer, options);
-  const core::Camera camera(scene.camera, scene.image.width, scene.image.height);
-  const core::Image image = renderer_->render(camera, options, pool_);
-  f.timing.render = secondsSince(t);
-  t = Clock::now();
-  const std::vector<std::uint8_t> raw = core::toSrgbRgba8(image, scene.image.background);
-  uLongf size = compressBound(uLong(raw.size()));
-  f.pixels.resize(size);
-  if (compress2(f.pixels.data(), &size, raw.data(), uLong(raw.size()), Z_BEST_SPEED) != Z_OK)
-    throw pvr::Error(pvr::ErrorCode::kInternal, "zlib compression failed");
-  f.pixels.resize(size);
-  f.timing.send = secondsSince(t);
-  ++frames_;
-  send(f, id, final);
+bool Master::handleAtOnce(const proto::Decoded& frame) {
+  const std::uint32_t id = frame.info.requestId;
+  if (std::holds_alternative<proto::StatusRequest>(frame.message)) {
+    handle(frame);
+    return true;
+  }
+  if (const auto* p = std::get_if<proto::PerformanceRequest>(&frame.message)) {
+    performance(*p, id);
+    return true;
+  }
+  if (const auto* c = std::get_if<proto::Cancel>(&frame.message)) {
+    if (c->target == running_) cancelled_ = true;
+    send(proto::Ok{}, id);
+    return true;
+  }
+  return false;
+}
+
+// Frames go out in waves of one frame per group: the groups render their
+// frames at once, composite, and the collector sends them in order. Between
+// waves the master answers Status, Performance and Cancel.
+void Master::renderSequence(const std::vector<core::CameraSpec>& cameras, std::uint32_t id) {
+  running_ = id;
+  cancelled_ = false;
+  const int last = int(cameras.size()) - 1;
+  state_.sendFrame = [&](proto::ImageFrame&& f, bool final) {
+    ++frames_;
+    send(f, id, final);
+  };
+  const std::size_t groups = std::size_t(state_.layout.groups);
+  for (std::size_t first = 0; first < cameras.size() && open_; first += groups) {
+    nlohmann::json frames = nlohmann::json::array();
+    for (std::size_t k = first; k < std::min(cameras.size(), first + groups); ++k)
+      frames.push_back({{"frame", k}, {"camera", cameraToJson(cameras[k])}});
+    double dist = 0;
+    auto failure = invoke(state_, "render", {{"frames", frames}}, &dist);
+    if (!failure) failure = invoke(state_, "composite");
+    if (!failure) failure = invoke(state_, "collect", {{"request", id}, {"last_frame", last}, {"dist", dist}});
+    if (failure) {
+      replyFailure(*failure, id);
+      break;
+    }
+    // Between waves: answer what must not wait; keep the rest for later.
+    while (auto frame = next(false)) {
+      if (!handleAtOnce(*frame)) pending_.push_back(std::move(*frame));
+    }
+    if (cancelled_ && first + groups < cameras.size()) {
+      send(proto::ErrorMessage{ErrorCode::kCancelled, "cancelled after " + std::to_string(first + groups) + " frames"}, id);
+      break;
+    }
+  }
+  state_.sendFrame = nullptr;
+  running_ = 0;
 }
 
 void Master::handle(const proto::Decoded& frame) {
@@ -160,38 +234,44 @@ void Master::handle(const proto::Decoded& frame) {
         [&](const auto& m) {
           using T = std::decay_t<decltype(m)>;
           if constexpr (std::is_same_v<T, proto::Hello>) {
-            send(proto::Welcome{"pvr-node 0.1", std::uint32_t(opt_.ranks), false}, id);
+            send(proto::Welcome{"pvr-node 0.2", std::uint32_t(state_.world.size()), false}, id);
           } else if constexpr (std::is_same_v<T, proto::SessionOpen> || std::is_same_v<T, proto::SetLayout>) {
-            send(proto::SessionReady{std::uint32_t(opt_.ranks), {{proto::ClusterRole::kRender, std::uint32_t(opt_.ranks), 0}}},
-                 id);
+            layout(m.clusters, id);
           } else if constexpr (std::is_same_v<T, proto::StatusRequest>) {
-            send(proto::StatusReply{{{"state", "session open"},
-                                     {"ranks", std::to_string(opt_.ranks)},
-                                     {"master_pid", std::to_string(::getpid())},
-                                     {"dataset", volumePath_},
-                                     {"frames_rendered", std::to_string(frames_)}}},
-                 id);
+            std::vector<proto::KeyValue> entries{{"state", running_ ? "rendering" : "session open"},
+                                                 {"ranks", std::to_string(state_.world.size())},
+                                                 {"master_pid", std::to_string(::getpid())},
+                                                 {"clusters", std::to_string(state_.layout.clusters.size())},
+                                                 {"groups", std::to_string(state_.layout.groups)},
+                                                 {"dataset", state_.source ? state_.source->describe() : ""},
+                                                 {"frames_rendered", std::to_string(frames_)},
+                                                 {"rebalances", std::to_string(state_.rebalances)}};
+            send(proto::StatusReply{entries}, id);
           } else if constexpr (std::is_same_v<T, proto::SetScene>) {
-            setScene(m);
-            send(proto::Ok{}, id);
+            setScene(m, id);
           } else if constexpr (std::is_same_v<T, proto::RenderFrame>) {
-            renderOne(resolvedScene(), 0, id, true);
+            if (!state_.source) throw Error(pvr::ErrorCode::kInvalidArgument, "no dataset: send SetScene with a dataset first");
+            renderSequence({state_.scene.camera}, id);
           } else if constexpr (std::is_same_v<T, proto::RenderRotation>) {
-            if (m.stepsPerTurn == 0 || m.end < m.start || m.end - m.start >= 100000)
-              throw pvr::Error(pvr::ErrorCode::kInvalidArgument, "rotation needs start <= end and stepsPerTurn >= 1");
+            if (m.stepsPerTurn == 0 || m.end < m.start || std::int64_t(m.end) - m.start >= 100000)
+              throw Error(pvr::ErrorCode::kInvalidArgument, "rotation needs start <= end and stepsPerTurn >= 1");
             const double len = std::sqrt(m.axis[0] * m.axis[0] + m.axis[1] * m.axis[1] + m.axis[2] * m.axis[2]);
-            if (!(len > 0)) throw pvr::Error(pvr::ErrorCode::kInvalidArgument, "rotation axis is zero");
+            if (!(len > 0) || !std::isfinite(len)) throw Error(pvr::ErrorCode::kInvalidArgument, "rotation axis is zero");
+            if (!state_.source) throw Error(pvr::ErrorCode::kInvalidArgument, "no dataset: send SetScene with a dataset first");
             const core::Vec3 axis{m.axis[0] / len, m.axis[1] / len, m.axis[2] / len};
-            const core::Scene base = resolvedScene();
-            for (std::int32_t k = m.start; k <= m.end && open_; ++k) {
-              core::Scene scene = base;
+            const core::CameraSpec base = state_.scene.camera;
+            std::vector<core::CameraSpec> cameras;
+            for (std::int32_t k = m.start; k <= m.end; ++k) {
+              core::CameraSpec c = base;
               const double angle = 2 * M_PI * double(k) / double(m.stepsPerTurn);
-              const core::Vec3 c = base.camera.lookAt;
-              const core::Vec3 e = rotate({base.camera.eye.x - c.x, base.camera.eye.y - c.y, base.camera.eye.z - c.z}, axis, angle);
-              scene.camera.eye = {c.x + e.x, c.y + e.y, c.z + e.z};
-              scene.camera.up = rotate(base.camera.up, axis, angle);
-              renderOne(scene, std::uint32_t(k - m.start), id, k == m.end);
+              const core::Vec3 e = rotate(base.eye - base.lookAt, axis, angle);
+              c.eye = base.lookAt + e;
+              c.up = rotate(base.up, axis, angle);
+              cameras.push_back(c);
             }
+            renderSequence(cameras, id);
+          } else if constexpr (std::is_same_v<T, proto::PerformanceRequest>) {
+            performance(m, id);
           } else if constexpr (std::is_same_v<T, proto::Cancel>) {
             send(proto::Ok{}, id);  // requests run one at a time: the target has finished
           } else if constexpr (std::is_same_v<T, proto::Close>) {
@@ -201,27 +281,24 @@ void Master::handle(const proto::Decoded& frame) {
           }
         },
         frame.message);
+  } catch (const Error& e) {
+    send(proto::ErrorMessage{wireCode(e.code()), e.what()}, id);
   } catch (const std::exception& e) {
-    send(proto::ErrorMessage{wireCode(e), e.what()}, id);
+    send(proto::ErrorMessage{ErrorCode::kInternal, e.what()}, id);
   }
 }
 
 void Master::serve() {
-  proto::FrameDecoder decoder;
-  std::vector<std::uint8_t> buf(64 << 10);
   while (open_) {
-    const ssize_t n = ::read(fd_, buf.data(), buf.size());
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    decoder.feed(std::span(buf.data(), std::size_t(n)));
-    while (auto frame = decoder.pop()) {
-      handle(*frame);
-      if (!open_) break;
+    std::optional<proto::Decoded> frame;
+    if (!pending_.empty()) {
+      frame = std::move(pending_.front());
+      pending_.pop_front();
+    } else {
+      frame = next(true);
     }
-    if (decoder.error()) {
-      send(proto::ErrorMessage{decoder.error()->code, decoder.error()->text}, 0);
-      break;
-    }
+    if (!frame) break;
+    handle(*frame);
   }
 }
 
@@ -262,6 +339,14 @@ bool parseServerOptions(int argc, char** argv, ServerOptions& options, std::stri
       options.port = std::atoi(v.c_str() + colon + 1);
     } else if (a == "--data-dir") {
       options.dataDir = v;
+    } else if (a == "--fail-once") {
+      if (v.find('@') == std::string::npos) {
+        error = "--fail-once takes ACTION@RANK";
+        return false;
+      }
+      options.failOnce = v;
+    } else if (a == "--dump-frames") {
+      options.dumpFrames = v;
     } else {
       error = "unknown option " + a;
       return false;
@@ -275,25 +360,56 @@ bool parseServerOptions(int argc, char** argv, ServerOptions& options, std::stri
 }
 
 int runServer(const ServerOptions& options) {
-  int status = 0;
-  if (options.rank == 0) {
-    const int fd = connectTo(options.host, options.port);
+  composite::MpiEnvironment mpi(nullptr, nullptr);
+  composite::Communicator& world = mpi.world();
+  char real[PATH_MAX];
+  NodeState state(world, ::realpath(options.dataDir.c_str(), real) ? real : "");
+  if (const auto at = options.failOnce.find('@'); at != std::string::npos) {
+    state.failAction = options.failOnce.substr(0, at);
+    state.failRank = std::atoi(options.failOnce.c_str() + at + 1);
+  }
+  state.dumpDir = options.dumpFrames;
+
+  int fd = -1;
+  if (world.rank() == 0) {
+    fd = connectTo(options.host, options.port);
     if (fd < 0) {
       std::fprintf(stderr, "pvr-node: rank 0 cannot connect to %s:%d: %s\n", options.host.c_str(), options.port,
                    std::strerror(errno));
-      MPI_Abort(MPI_COMM_WORLD, 1);
+      std::fflush(stderr);
+      std::abort();  // mpirun ends the other ranks
     }
-    Master(options, fd).serve();
-    ::close(fd);
   }
-  // The other ranks wait without spinning a core until the master is done.
-  MPI_Request request;
-  MPI_Ibarrier(MPI_COMM_WORLD, &request);
-  int finished = 0;
-  while (!finished) {
-    MPI_Test(&request, &finished, MPI_STATUS_IGNORE);
-    if (!finished) ::usleep(20000);
+  // Same table everywhere, or nobody starts.
+  try {
+    checkActionTables(world);
+  } catch (const Error& e) {
+    if (fd >= 0) {
+      const auto bytes = proto::encode(proto::ErrorMessage{ErrorCode::kInternal, e.what()}, 0, proto::kFlagFinal);
+      [[maybe_unused]] auto n = ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+      ::close(fd);
+      std::fprintf(stderr, "pvr-node: %s\n", e.what());
+    }
+    return 1;
   }
+  if (world.rank() != 0) {
+    serveSlave(state);
+    return 0;
+  }
+  // The default layout (one render cluster of every rank) and the
+  // compositing model's calibration; SessionOpen's layout follows.
+  int status = 0;
+  if (auto f = invoke(state, "set_layout", {{"clusters", nlohmann::json::array()}})) {
+    std::fprintf(stderr, "pvr-node: %s\n", f->describe().c_str());
+    status = 1;
+  } else if (auto g = invoke(state, "calibrate")) {
+    std::fprintf(stderr, "pvr-node: %s\n", g->describe().c_str());
+    status = 1;
+  } else {
+    Master(state, fd).serve();
+  }
+  invoke(state, "shutdown");
+  ::close(fd);
   return status;
 }
 

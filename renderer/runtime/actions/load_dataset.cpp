@@ -1,0 +1,30 @@
+// load_dataset {"scene": document, "runtime": settings}: opens the scene's
+// volume on every rank (headers only) and has each render cluster read it
+// as bricks plus ghost layers, each rank its own box straight from the file
+// (or its cluster's rank 0 scattering for formats that cannot read part of
+// a file; distribute.h).
+#include "../data.h"
+#include "../node.h"
+
+namespace pvr::runtime::actions {
+
+void loadDataset(NodeState& state, const ActionArgs& args) {
+  runAgreedOn(state.world, state.world.rank(), [&] {
+    const RuntimeSettings settings = settingsFrom(args.value("runtime", nlohmann::json::object()), state.settings);
+    const RuntimeSettings old = state.settings;
+    state.settings = settings;
+    try {
+      openScene(state, args.at("scene"));
+    } catch (...) {
+      state.settings = old;
+      throw;
+    }
+    if (state.poolThreads != state.settings.threads) {
+      state.pool = std::make_unique<core::ThreadPool>(state.settings.threads);
+      state.poolThreads = state.settings.threads;
+    }
+  });
+  distributeData(state);
+}
+
+}  // namespace pvr::runtime::actions

@@ -1,0 +1,33 @@
+// set_scene {"scene": document, "runtime": settings}: new transfer function,
+// camera, image size, sampling or runtime settings (docs/runtime.md). Opens
+// and distributes the volume if it changed (as load_dataset), re-reads
+// bricks when the ghost layers or the decomposition change, and rebalances
+// a content-balanced decomposition that the new transfer function leaves
+// uneven (data.h).
+#include "../data.h"
+#include "../node.h"
+
+namespace pvr::runtime::actions {
+
+void setScene(NodeState& state, const ActionArgs& args) {
+  bool redistribute = false;
+  runAgreedOn(state.world, state.world.rank(), [&] {
+    const RuntimeSettings old = state.settings;
+    state.settings = settingsFrom(args.value("runtime", nlohmann::json::object()), old);
+    try {
+      redistribute = openScene(state, args.at("scene")) || state.settings.decomposition != old.decomposition;
+    } catch (...) {
+      state.settings = old;
+      throw;
+    }
+    if (state.poolThreads != state.settings.threads) {
+      state.pool = std::make_unique<core::ThreadPool>(state.settings.threads);
+      state.poolThreads = state.settings.threads;
+    }
+    classify(state);
+  });
+  if (redistribute) distributeData(state);
+  else rebalanceIfNeeded(state);
+}
+
+}  // namespace pvr::runtime::actions
