@@ -1,0 +1,22 @@
+# gui.tcl -- the PVR GUI (paper 003, Figure 13).
+#
+#   pvrsh examples/gui.tcl ?-host HOST:PORT? ?-ranks N? ?-dataset NAME?
+#                          ?-imagesz WxH? ?-datadir DIR?
+#
+# With -host it connects at once (otherwise type the address and press
+# Connect; PVR_HOST sets the default). -dataset picks a catalog entry (a
+# directory name picks the sidecar inside it). -datadir is pvrd's data
+# directory when this machine can read it: the transfer-function editor then
+# shows the dataset's scalar range and histogram.
+#
+# Drag the image to turn the view; the arrows turn it by 15 degrees. The
+# transfer-function editor applies every change at once. "Clusters and
+# groups" sets -cluster/-group; the second window graphs each frame's times.
+package require Tk
+if {[catch {package require pvr}]} {
+    # Under plain wish: the package from the build tree.
+    lappend auto_path [file join [file dirname [info script]] .. build lib]
+    package require pvr
+}
+source [file join [file dirname [file normalize [info script]]] .. tcl gui.tcl]
+::pvr::gui::main {*}$argv

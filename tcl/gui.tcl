@@ -1,0 +1,489 @@
+# gui.tcl -- the PVR GUI after Figure 13 of paper 003, started by
+# `pvrsh examples/gui.tcl ?-host HOST:PORT? ?-ranks N? ?-dataset NAME?
+# ?-imagesz WxH? ?-datadir DIR?`.
+#
+# Windows:
+#   .       image view (drag to rotate), connection, dataset, image size,
+#           view buttons, rotation sequences, transfer-function editor,
+#           progress bar and status line
+#   .stat   per-frame times, dist/rend/comp/comm/send (stat.tcl)
+#   .layout cluster and group configuration (gui_layout.tcl)
+#
+# One session, :pvrgui. Frames go into the photo ::pvr::gui::image through
+# `:s image window`; `:s image callback` reports each frame's timing, and
+# `:s notify` (done, cancelled, error) ends a request. Every request goes
+# through ::pvr::gui::view, which keeps at most one in flight.
+#
+# -datadir names the daemon's data directory when it is readable here (pvrd
+# on this machine): the dataset's JSON sidecar then gives the scalar range
+# and histogram for the transfer-function editor. Without it the editor
+# shows a plain ramp over the range typed in its fields.
+
+package require Tk 8.6
+
+namespace eval ::pvr::gui {
+    variable dir [file dirname [file normalize [info script]]]
+    # The session object command and the photo frames go into.
+    variable session :pvrgui
+    variable image ::pvr::gui::image
+    # Connection and scene settings, bound to widgets.
+    variable opt
+    array set opt {
+        host 127.0.0.1:7350
+        ranks 1
+        dataset ""
+        imagesz 512x512
+        datadir ""
+        tflo 0
+        tfhi 1
+        axis 0,0,1
+        range 0,35:36
+    }
+    # Status line text and its kind (info, busy, error); progress bar value.
+    variable statusText "not connected"
+    variable progress 0
+    # The request in flight: kind (frame or sequence), frames done, total,
+    # and its start in microseconds.
+    variable request [dict create kind none done 0 total 0 start 0]
+    # Request-to-pixels latency of the last single frame, seconds.
+    variable lastLatency 0
+    # A transfer-function change waits here until the request in flight ends.
+    variable tfPending 0
+    # Whether the session is open (kept here: `list status` asks the server).
+    variable connected 0
+}
+
+foreach file {stat.tcl tfeditor.tcl gui_view.tcl gui_layout.tcl} {
+    source [file join $::pvr::gui::dir $file]
+}
+unset file
+
+# ::pvr::gui::main --
+#   Builds the windows, and connects when -host was given.
+# Arguments: option value pairs (see the file header).
+proc ::pvr::gui::main {args} {
+    variable opt
+    variable session
+    if {[llength $args] % 2 != 0} {
+        return -code error -errorcode {PVR ARGS} \
+            "usage: gui.tcl ?-host HOST:PORT? ?-ranks N? ?-dataset NAME? ?-imagesz WxH? ?-datadir DIR?"
+    }
+    set connect 0
+    foreach {key value} $args {
+        set name [string range $key 1 end]
+        if {$name ni {host ranks dataset imagesz datadir}} {
+            return -code error -errorcode {PVR ARGS OPTION} \
+                "bad option \"$key\": must be -host, -ranks, -dataset, -imagesz or -datadir"
+        }
+        set opt($name) $value
+        if {$name eq "host"} {
+            set connect 1
+        }
+    }
+    if {[info exists ::env(PVR_HOST)] && !$connect} {
+        set opt(host) $::env(PVR_HOST)
+    }
+    # The GUI shows progress itself; no per-frame lines on stderr.
+    set ::pvr::progress 0
+    interp bgerror {} ::pvr::gui::backgroundError
+    buildMain
+    buildStat
+    if {[info commands $session] eq ""} {
+        pvr_session $session
+    }
+    $session image window $::pvr::gui::image
+    $session image callback ::pvr::gui::onFrame
+    $session notify ::pvr::gui::onNotify
+    ::pvr::gui::view::attach .view.image [list ::pvr::gui::send]
+    if {$connect} {
+        after idle ::pvr::gui::connect
+    }
+}
+
+# ---- Windows ----
+
+proc ::pvr::gui::buildMain {} {
+    variable image
+    variable opt
+    wm title . "PVR"
+    lassign [split $opt(imagesz) x] width height
+    image create photo $image -width $width -height $height
+    $image put #202020 -to 0 0 $width $height
+
+    # Left: the image view. Right: the controls.
+    ttk::frame .view -padding 4
+    label .view.image -image $image -background black -borderwidth 0 -cursor fleur
+    pack .view.image
+    ttk::frame .ctl -padding 4
+
+    # Connection.
+    set f [ttk::labelframe .ctl.conn -text "Server" -padding 4]
+    ttk::entry $f.host -width 20 -textvariable ::pvr::gui::opt(host)
+    ttk::label $f.rl -text "ranks"
+    ttk::spinbox $f.ranks -from 1 -to 256 -width 4 -textvariable ::pvr::gui::opt(ranks)
+    ttk::button $f.open -text "Connect" -command ::pvr::gui::toggleConnection
+    pack $f.host $f.rl $f.ranks $f.open -side left -padx 2
+
+    # Dataset and image size.
+    set f [ttk::labelframe .ctl.data -text "Dataset and image" -padding 4]
+    ttk::combobox $f.dataset -width 34 -state readonly -textvariable ::pvr::gui::opt(dataset)
+    bind $f.dataset <<ComboboxSelected>> {::pvr::gui::loadDataset $::pvr::gui::opt(dataset)}
+    ttk::label $f.sl -text "image size"
+    ttk::combobox $f.size -width 10 -textvariable ::pvr::gui::opt(imagesz) \
+        -values {256x256 384x384 512x512 640x480 768x768 1024x1024}
+    bind $f.size <<ComboboxSelected>> ::pvr::gui::applyImageSize
+    bind $f.size <Return> ::pvr::gui::applyImageSize
+    grid $f.dataset - -sticky we -pady 2
+    grid $f.sl $f.size -sticky w -pady 2
+
+    # View: buttons turn by 15 degrees; the image turns by dragging.
+    set f [ttk::labelframe .ctl.view -text "View (drag the image to rotate)" -padding 4]
+    ttk::button $f.left -text "\u25c0" -width 3 -command {::pvr::gui::view::turn -15 0}
+    ttk::button $f.right -text "\u25b6" -width 3 -command {::pvr::gui::view::turn 15 0}
+    ttk::button $f.up -text "\u25b2" -width 3 -command {::pvr::gui::view::turn 0 15}
+    ttk::button $f.down -text "\u25bc" -width 3 -command {::pvr::gui::view::turn 0 -15}
+    ttk::button $f.reset -text "Reset" -command ::pvr::gui::view::reset
+    ttk::button $f.render -text "Render" -command ::pvr::gui::view::request
+    ttk::label $f.angles -width 30 -textvariable ::pvr::gui::anglesText
+    grid x $f.up x $f.reset -padx 1 -pady 1
+    grid $f.left $f.render $f.right $f.angles -padx 1 -pady 1
+    grid x $f.down x -padx 1 -pady 1
+    trace add variable ::pvr::gui::view::azimuth write ::pvr::gui::showAngles
+    trace add variable ::pvr::gui::view::elevation write ::pvr::gui::showAngles
+    showAngles
+
+    # Rotation sequences, Table 1: render rotate X,Y,Z S,E:N.
+    set f [ttk::labelframe .ctl.seq -text "Rotation sequence" -padding 4]
+    ttk::label $f.al -text "axis"
+    ttk::entry $f.axis -width 8 -textvariable ::pvr::gui::opt(axis)
+    ttk::label $f.rl -text "S,E:N"
+    ttk::entry $f.range -width 9 -textvariable ::pvr::gui::opt(range)
+    ttk::button $f.go -text "Render" -command ::pvr::gui::renderSequence
+    ttk::button $f.cancel -text "Cancel" -command ::pvr::gui::cancel
+    pack $f.al $f.axis $f.rl $f.range $f.go $f.cancel -side left -padx 2
+
+    # Transfer function: the editor and its scalar range.
+    set f [ttk::labelframe .ctl.tf -text "Transfer function (drag, click to add, right-click to remove)" -padding 4]
+    ::pvr::gui::tfeditor::create $f.editor -command ::pvr::gui::tfChanged -width 380 -height 150
+    ttk::frame $f.range
+    ttk::label $f.range.l -text "scalar range"
+    ttk::entry $f.range.lo -width 9 -textvariable ::pvr::gui::opt(tflo)
+    ttk::entry $f.range.hi -width 9 -textvariable ::pvr::gui::opt(tfhi)
+    ttk::button $f.range.set -text "Set" -command ::pvr::gui::applyTfRange
+    pack $f.range.l $f.range.lo $f.range.hi $f.range.set -side left -padx 2
+    pack $f.editor -fill both -expand 1
+    pack $f.range -anchor w -pady 2
+
+    # Other windows.
+    set f [ttk::frame .ctl.more]
+    ttk::button $f.layout -text "Clusters and groups\u2026" -command {::pvr::gui::layout::show $::pvr::gui::session}
+    ttk::button $f.stat -text "Performance graph\u2026" -command {wm deiconify .stat; raise .stat}
+    pack $f.layout $f.stat -side left -padx 2
+
+    pack .ctl.conn .ctl.data .ctl.view .ctl.seq .ctl.tf .ctl.more -fill x -pady 3
+
+    # Bottom: progress bar and status line.
+    ttk::frame .bar -padding {4 2}
+    ttk::progressbar .bar.progress -length 160 -mode determinate -variable ::pvr::gui::progress
+    ttk::label .bar.status -textvariable ::pvr::gui::statusText -anchor w
+    pack .bar.progress -side left
+    pack .bar.status -side left -fill x -expand 1 -padx 6
+
+    grid .view .ctl -sticky nw
+    grid .bar - -sticky we
+    grid columnconfigure . 1 -weight 1
+}
+
+proc ::pvr::gui::buildStat {} {
+    toplevel .stat
+    wm title .stat "PVR frame times"
+    canvas .stat.c -width 520 -height 200
+    pack .stat.c -fill both -expand 1
+    ::pvr::gui::stat::attach .stat.c
+    wm protocol .stat WM_DELETE_WINDOW {wm withdraw .stat}
+    # Below the main window (a window manager may place it elsewhere).
+    update idletasks
+    wm geometry .stat +[winfo rootx .]+[expr {[winfo rooty .] + [winfo reqheight .] + 40}]
+}
+
+proc ::pvr::gui::showAngles {args} {
+    set ::pvr::gui::anglesText [format "azimuth %5.1f\u00b0 elevation %5.1f\u00b0" \
+                                    $::pvr::gui::view::azimuth $::pvr::gui::view::elevation]
+}
+
+# ::pvr::gui::status --
+#   Sets the status line; kind is info, busy or error (red).
+proc ::pvr::gui::status {text {kind info}} {
+    variable statusText
+    set statusText $text
+    if {[winfo exists .bar.status]} {
+        .bar.status configure -foreground [expr {$kind eq "error" ? "#b00000" : "black"}]
+    }
+    if {$kind eq "error"} {
+        puts stderr "pvr gui: $text"
+    }
+}
+
+proc ::pvr::gui::backgroundError {message options} {
+    status $message error
+}
+
+# ---- Connection and dataset ----
+
+proc ::pvr::gui::toggleConnection {} {
+    variable connected
+    if {$connected} {
+        disconnect
+    } else {
+        connect
+    }
+}
+
+proc ::pvr::gui::markConnected {on} {
+    variable connected
+    set connected $on
+    if {[winfo exists .ctl.conn.open]} {
+        .ctl.conn.open configure -text [expr {$on ? "Disconnect" : "Connect"}]
+    }
+}
+
+# ::pvr::gui::connect --
+#   Opens the session, lists the catalog, and loads -dataset (or the first
+#   dataset). Results: 1 when connected.
+proc ::pvr::gui::connect {} {
+    variable session
+    variable opt
+    status "connecting to $opt(host) with $opt(ranks) ranks\u2026" busy
+    .ctl.conn.open configure -state disabled
+    set failed [catch {$session open $opt(host) -ranks $opt(ranks)} message]
+    .ctl.conn.open configure -state normal
+    if {$failed} {
+        status "cannot connect: $message" error
+        return 0
+    }
+    markConnected 1
+    set datasets {}
+    if {[catch {$session list datasets} datasets]} {
+        status "connected; no catalog: $datasets" error
+        set datasets {}
+    }
+    .ctl.data.dataset configure -values $datasets
+    set name $opt(dataset)
+    if {$name ne "" && $name ni $datasets} {
+        # A directory name stands for the sidecar inside it.
+        set match [lsearch -inline -glob $datasets $name/*]
+        set name [expr {$match ne "" ? $match : $name}]
+    }
+    if {$name eq "" && [llength $datasets] > 0} {
+        set name [lindex $datasets 0]
+    }
+    status "connected to $opt(host): [llength $datasets] datasets"
+    if {$name ne ""} {
+        loadDataset $name
+    }
+    return 1
+}
+
+proc ::pvr::gui::disconnect {} {
+    variable session
+    catch {$session close}
+    markConnected 0
+    ::pvr::gui::view::finished
+    status "disconnected"
+}
+
+# ::pvr::gui::sidecar --
+#   Scalar range and histogram of dataset `name` from its JSON sidecar under
+#   -datadir: a dict with lo, hi and, when present, edges and fractions;
+#   empty when unknown. The sidecar's layout is fixed (see the data README),
+#   so a few patterns read it without a JSON package.
+proc ::pvr::gui::sidecar {name} {
+    variable opt
+    if {$opt(datadir) eq "" || [file extension $name] ne ".json"} {
+        return {}
+    }
+    set path [file join $opt(datadir) $name]
+    if {[catch {set f [open $path]; set text [read $f]; close $f}]} {
+        return {}
+    }
+    set info {}
+    set num {-?[0-9.]+(?:[eE][-+]?[0-9]+)?}
+    if {[regexp "\"min\":\\s*($num)" $text -> lo] && [regexp "\"max\":\\s*($num)" $text -> hi] && $lo < $hi} {
+        dict set info lo $lo
+        dict set info hi $hi
+    }
+    if {[regexp {"edges":\s*\[([^\]]*)\]} $text -> edges] && [regexp {"fractions":\s*\[([^\]]*)\]} $text -> fractions]} {
+        dict set info edges [string map {, " "} $edges]
+        dict set info fractions [string map {, " "} $fractions]
+    }
+    return $info
+}
+
+# ::pvr::gui::loadDataset --
+#   Selects dataset `name`, fits the transfer function to its range when
+#   known, and renders a frame.
+proc ::pvr::gui::loadDataset {name} {
+    variable session
+    variable opt
+    set opt(dataset) $name
+    set editor .ctl.tf.editor
+    set info [sidecar $name]
+    if {[dict exists $info lo]} {
+        set opt(tflo) [dict get $info lo]
+        set opt(tfhi) [dict get $info hi]
+        ::pvr::gui::tfeditor::range $editor $opt(tflo) $opt(tfhi)
+    }
+    if {[dict exists $info edges]} {
+        ::pvr::gui::tfeditor::histogram $editor [dict get $info edges] [dict get $info fractions]
+    } else {
+        ::pvr::gui::tfeditor::histogram $editor {} {}
+    }
+    lassign [split $opt(imagesz) x] w h
+    if {[catch {$session set -dataset $name -imagesz $w,$h -tf [::pvr::gui::tfeditor::points $editor]} message]} {
+        status "dataset $name: $message" error
+        return
+    }
+    ::pvr::gui::stat::clear .stat.c
+    status "dataset $name"
+    ::pvr::gui::view::request
+}
+
+proc ::pvr::gui::applyImageSize {} {
+    variable session
+    variable opt
+    if {![regexp {^\s*(\d+)\s*[x,]\s*(\d+)\s*$} $opt(imagesz) -> w h]} {
+        status "image size must be WxH, got '$opt(imagesz)'" error
+        return
+    }
+    if {[catch {$session set -imagesz $w,$h} message]} {
+        status "image size: $message" error
+        return
+    }
+    ::pvr::gui::view::request
+}
+
+# ---- Transfer function ----
+
+proc ::pvr::gui::applyTfRange {} {
+    variable opt
+    if {[catch {::pvr::gui::tfeditor::range .ctl.tf.editor $opt(tflo) $opt(tfhi)} message]} {
+        status $message error
+        return
+    }
+    tfChanged [::pvr::gui::tfeditor::points .ctl.tf.editor]
+}
+
+# ::pvr::gui::tfChanged --
+#   The editor changed: the newest points go out with the next request
+#   (::pvr::gui::send), which is now when idle, otherwise when the request
+#   in flight ends.
+proc ::pvr::gui::tfChanged {points} {
+    variable tfPending
+    variable connected
+    if {!$connected} {
+        return
+    }
+    set tfPending 1
+    ::pvr::gui::view::request
+}
+
+# ---- Requests and arrivals ----
+
+# ::pvr::gui::send --
+#   The view's sender: `render frame` or `render rotate AXIS K,K:N`, timed
+#   from here to the frame in the photo. Sends pending TF points first.
+proc ::pvr::gui::send {args} {
+    variable session
+    variable request
+    variable tfPending
+    if {$tfPending} {
+        set tfPending 0
+        $session set -tf [::pvr::gui::tfeditor::points .ctl.tf.editor]
+    }
+    set start [clock microseconds]
+    set total [$session render {*}$args]
+    set request [dict create kind frame done 0 total $total start $start]
+    status "rendering\u2026" busy
+}
+
+proc ::pvr::gui::renderSequence {} {
+    variable session
+    variable opt
+    variable request
+    if {$::pvr::gui::view::busy} {
+        status "a request is in flight; cancel it first" error
+        return
+    }
+    set start [clock microseconds]
+    if {[catch {$session render rotate $opt(axis) $opt(range)} total]} {
+        status "render rotate: $total" error
+        return
+    }
+    set ::pvr::gui::view::busy 1
+    set request [dict create kind sequence done 0 total $total start $start]
+    set ::pvr::gui::progress 0
+    .bar.progress configure -maximum $total
+    status "rotate $opt(axis) $opt(range): 0/$total frames" busy
+}
+
+proc ::pvr::gui::cancel {} {
+    variable session
+    if {[catch {$session cancel} n]} {
+        status "cancel: $n" error
+    }
+}
+
+# ::pvr::gui::onFrame --
+#   `:s image callback`: the frame is in the photo already. Updates the
+#   graph, the progress bar and the status line.
+proc ::pvr::gui::onFrame {frame timing} {
+    variable request
+    variable lastLatency
+    set now [clock microseconds]
+    dict incr request done
+    set done [dict get $request done]
+    set total [dict get $request total]
+    set elapsed [expr {($now - [dict get $request start]) / 1e6}]
+    # The graph's arrival tick: from the request for a single frame, from
+    # the previous frame within a sequence.
+    set since [expr {[dict exists $request last] ? [dict get $request last] : [dict get $request start]}]
+    dict set request last $now
+    dict set timing arrival [expr {($now - $since) / 1e6}]
+    ::pvr::gui::stat::add .stat.c $frame $timing
+    if {[dict get $request kind] eq "sequence"} {
+        set ::pvr::gui::progress $done
+        set fps [expr {$elapsed > 0 ? $done / $elapsed : 0}]
+        set left [expr {$fps > 0 ? ($total - $done) / $fps : 0}]
+        status [format "frame %d: %d/%d, %.1f fps, %.1f s left" $frame $done $total $fps $left] busy
+    } else {
+        set lastLatency $elapsed
+        set ::pvr::gui::progress 0
+        status [format "frame %d in %.0f ms (render %.0f ms)" $frame [expr {$elapsed * 1e3}] \
+                    [expr {[::pvr::gui::stat::phaseValue $timing rend] * 1e3}]]
+    }
+}
+
+# ::pvr::gui::onNotify --
+#   `:s notify`: done N, cancelled N, or error MESSAGE CODE. A request ends
+#   with done or cancelled; the next coalesced request goes out then.
+proc ::pvr::gui::onNotify {event args} {
+    variable request
+    switch -- $event {
+        done - cancelled {
+            if {[dict get $request kind] eq "sequence"} {
+                set done [dict get $request done]
+                set secs [expr {([clock microseconds] - [dict get $request start]) / 1e6}]
+                status [format "sequence %s: %d frames in %.1f s" $event $done $secs]
+            }
+            dict set request kind none
+            ::pvr::gui::view::finished
+        }
+        error {
+            lassign $args message code
+            if {[lrange $code 0 1] eq {PVR CONNECT}} {
+                markConnected 0
+            }
+            status "server: $message" error
+        }
+    }
+}

@@ -1,0 +1,184 @@
+# gui_layout.tcl -- the cluster and group configuration window of the PVR GUI
+# (the left window of Figure 13 in paper 003).
+#
+# Rendering clusters hold the whole dataset split into bricks; clusters in
+# one group share the scanlines of a frame, groups take different frames
+# (`:s set -cluster r,RANKS -group 0,0,1,1`). Compositing is done by the
+# rendering ranks themselves, or by separate compositing clusters
+# (`-cluster c -group 0,0`). The window also asks the server what a layout
+# costs: dataset memory per cluster and the estimated compositing latency
+# (`:s performance memory cluster`, `:s performance comp cluster latency`).
+
+namespace eval ::pvr::gui::layout {
+    # The form's variables, bound to the widgets.
+    variable form
+    array set form {
+        renderRanks 1
+        renderGroups 0
+        composite self
+        compositeGroups 0
+        strategy binary-swap
+        decomposition kd
+    }
+}
+
+# ::pvr::gui::layout::show --
+#   Opens (or raises) the window .layout for session command `session`.
+proc ::pvr::gui::layout::show {session} {
+    set w .layout
+    if {[winfo exists $w]} {
+        wm deiconify $w
+        raise $w
+        refresh $session
+        return $w
+    }
+    toplevel $w
+    wm title $w "PVR clusters and groups"
+
+    # Step 1: the form.
+    set f [ttk::labelframe $w.render -text "Rendering clusters" -padding 6]
+    ttk::label $f.rl -text "Ranks per cluster"
+    ttk::spinbox $f.rs -from 1 -to 1024 -width 6 -textvariable ::pvr::gui::layout::form(renderRanks)
+    ttk::label $f.gl -text "Group of each cluster"
+    ttk::entry $f.ge -width 16 -textvariable ::pvr::gui::layout::form(renderGroups)
+    ttk::label $f.help -foreground #555555 -wraplength 300 -justify left \
+        -text "One number per cluster: 0,0,1,1 is four clusters in two groups. Clusters of a group split the scanlines of a frame; groups render different frames."
+    grid $f.rl $f.rs -sticky w -pady 2
+    grid $f.gl $f.ge -sticky w -pady 2
+    grid $f.help - -sticky w -pady 2
+
+    set c [ttk::labelframe $w.comp -text "Compositing" -padding 6]
+    ttk::radiobutton $c.self -text "Rendering ranks composite (binary swap among them)" \
+        -variable ::pvr::gui::layout::form(composite) -value self
+    ttk::radiobutton $c.sep -text "Separate compositing clusters, groups:" \
+        -variable ::pvr::gui::layout::form(composite) -value separate
+    ttk::entry $c.ge -width 10 -textvariable ::pvr::gui::layout::form(compositeGroups)
+    ttk::label $c.sl -text "Strategy"
+    ttk::combobox $c.sc -state readonly -width 14 -textvariable ::pvr::gui::layout::form(strategy) \
+        -values {binary-swap direct-send tree radix-k pipeline}
+    ttk::label $c.dl -text "Decomposition"
+    ttk::combobox $c.dc -state readonly -width 14 -textvariable ::pvr::gui::layout::form(decomposition) \
+        -values {kd balanced}
+    grid $c.self - -sticky w
+    grid $c.sep $c.ge -sticky w
+    grid $c.sl $c.sc -sticky w -pady 2
+    grid $c.dl $c.dc -sticky w -pady 2
+
+    # Step 2: what the server says about it.
+    set r [ttk::labelframe $w.report -text "Server" -padding 6]
+    text $r.t -width 52 -height 10 -wrap word -font TkFixedFont -relief flat -background #f4f4f4
+    ttk::frame $r.b
+    ttk::button $r.b.mem -text "Memory per cluster" -command [list ::pvr::gui::layout::query $session memory]
+    ttk::button $r.b.lat -text "Compositing latency" -command [list ::pvr::gui::layout::query $session comp]
+    ttk::button $r.b.ref -text "Refresh" -command [list ::pvr::gui::layout::refresh $session]
+    pack $r.b.mem $r.b.lat $r.b.ref -side left -padx 2
+    pack $r.b -anchor w
+    pack $r.t -fill both -expand 1
+
+    ttk::frame $w.buttons
+    ttk::button $w.buttons.apply -text "Apply" -command [list ::pvr::gui::layout::apply $session]
+    ttk::button $w.buttons.close -text "Close" -command [list wm withdraw $w]
+    pack $w.buttons.close $w.buttons.apply -side right -padx 4
+    pack $w.render $w.comp $w.report -fill x -padx 6 -pady 4
+    pack $w.buttons -fill x -padx 6 -pady 6
+    wm protocol $w WM_DELETE_WINDOW [list wm withdraw $w]
+    refresh $session
+    return $w
+}
+
+# ::pvr::gui::layout::report --
+#   Replaces the server text with `text`.
+proc ::pvr::gui::layout::report {text} {
+    if {![winfo exists .layout.report.t]} {
+        return
+    }
+    .layout.report.t delete 1.0 end
+    .layout.report.t insert end $text
+}
+
+# ::pvr::gui::layout::refresh --
+#   Shows the layout in force (`:s list status`), and fills the form from it.
+proc ::pvr::gui::layout::refresh {session} {
+    variable form
+    if {[catch {$session list status} status]} {
+        report "status: $status"
+        return
+    }
+    set lines [list "state [dict get $status state], [dict get $status ranks] ranks started"]
+    set renderGroups {}
+    set compositeGroups {}
+    foreach cluster [dict get $status layout] {
+        lassign $cluster role ranks group
+        lappend lines [format "  %-10s %4s ranks  group %s" $role [expr {$ranks == 0 ? "auto" : $ranks}] $group]
+        if {$role eq "render"} {
+            lappend renderGroups $group
+            if {$ranks > 0} {
+                set form(renderRanks) $ranks
+            }
+        } elseif {$role eq "composite"} {
+            lappend compositeGroups $group
+        }
+    }
+    if {$renderGroups ne {}} {
+        set form(renderGroups) [join $renderGroups ,]
+    }
+    if {$compositeGroups ne {}} {
+        set form(composite) separate
+        set form(compositeGroups) [join $compositeGroups ,]
+    }
+    set options [dict get $status options]
+    foreach {key option} {strategy -strategy decomposition -decomposition} {
+        if {[dict exists $options $option]} {
+            set form($key) [dict get $options $option]
+        }
+    }
+    report [join $lines \n]
+}
+
+# ::pvr::gui::layout::apply --
+#   Sends the form as -cluster/-group, -strategy and -decomposition settings.
+proc ::pvr::gui::layout::apply {session} {
+    variable form
+    set settings [list -cluster r,$form(renderRanks) -group $form(renderGroups) \
+                      -strategy $form(strategy) -decomposition $form(decomposition)]
+    if {[catch {
+        $session set {*}$settings
+        if {$form(composite) eq "separate"} {
+            $session set -cluster c -group $form(compositeGroups)
+        }
+    } message]} {
+        report "apply: $message"
+        ::pvr::gui::status "layout not applied: $message" error
+        return
+    }
+    ::pvr::gui::status "layout applied: [join $settings { }]"
+    refresh $session
+    ::pvr::gui::view::request
+}
+
+# ::pvr::gui::layout::query --
+#   `:s performance memory cluster` or `:s performance comp cluster latency`,
+#   shown as one line per cluster.
+proc ::pvr::gui::layout::query {session what} {
+    set words [expr {$what eq "memory" ? {memory cluster} : {comp cluster latency}}]
+    ::pvr::gui::status "asking the server: performance $words"
+    if {[catch {$session performance {*}$words} answer]} {
+        report "performance $words: $answer"
+        ::pvr::gui::status "performance $words: $answer" error
+        return
+    }
+    set lines [list "performance $words:"]
+    foreach item $answer {
+        if {[catch {dict size $item}]} {
+            lappend lines "  $item"
+            continue
+        }
+        set fields {}
+        dict for {k v} $item {
+            lappend fields "$k=$v"
+        }
+        lappend lines "  [join $fields {  }]"
+    }
+    report [join $lines \n]
+    ::pvr::gui::status "performance $words: [llength $answer] clusters"
+}

@@ -1,0 +1,260 @@
+# gui_test.tcl -- the PVR GUI against a real pvrd, driven with event generate.
+#
+#   xvfb-run -a pvrsh gui_test.tcl -pvrd PVRD -node PVR_NODE -source SRC -out DIR
+#
+# Starts pvrd on an ephemeral loopback port with a 32^3 volume that is not
+# symmetric about any axis (an off-centre block and a ball), opens the GUI
+# (tcl/gui.tcl) on it, and checks, by the photo's pixels:
+#   1. the first frame arrives after connecting;
+#   2. a drag on the image turns the view, coalesces its motion events into
+#      fewer requests, and changes the image;
+#   3. a press of the "turn right" button turns it by 15 degrees, another frame;
+#   4. dragging a transfer-function point renders again, with other pixels;
+#   5. a rotation sequence fills the progress bar and the performance graph.
+# Writes DIR/gui_frame.png (the photo) and DIR/gui_screenshot.png (the whole
+# screen, when ImageMagick's import is installed). Exits 0 when all pass, 1
+# otherwise; gives up after 50 s.
+
+package require Tk
+
+# ---- Options ----
+array set arg {-pvrd "" -node "" -source "" -out .}
+foreach {k v} $argv {
+    set arg($k) $v
+}
+foreach k {-pvrd -node -source} {
+    if {$arg($k) eq ""} {
+        puts stderr "usage: gui_test.tcl -pvrd PVRD -node PVR_NODE -source SRC -out DIR"
+        exit 2
+    }
+}
+file mkdir $arg(-out)
+
+set failures 0
+set pvrdChan ""
+
+# check: `condition` is an expression evaluated in the caller.
+proc check {name condition {detail ""}} {
+    if {[uplevel 1 [list expr $condition]]} {
+        puts "ok   $name"
+    } else {
+        puts "FAIL $name $detail"
+        incr ::failures
+    }
+}
+
+# finish: stops pvrd (SIGTERM: it ends its sessions and their MPI jobs) and exits.
+proc finish {} {
+    catch {:pvrgui close}
+    if {$::pvrdChan ne ""} {
+        foreach p [pid $::pvrdChan] {
+            catch {exec kill -TERM $p}
+        }
+        catch {close $::pvrdChan}
+    }
+    puts [expr {$::failures == 0 ? "gui test passed" : "gui test: $::failures failures"}]
+    exit [expr {$::failures == 0 ? 0 : 1}]
+}
+
+after 50000 {
+    puts "FAIL timeout: the GUI test did not finish in 50 s"
+    incr ::failures
+    finish
+}
+
+# waitFor: runs the event loop until `condition` (evaluated globally) holds,
+# or `seconds` pass. Results: 1 when it held.
+proc waitFor {condition seconds} {
+    set deadline [expr {[clock milliseconds] + int($seconds * 1000)}]
+    while {![uplevel #0 [list expr $condition]]} {
+        if {[clock milliseconds] > $deadline} {
+            return 0
+        }
+        after 20 {set ::tick 1}
+        vwait ::tick
+    }
+    return 1
+}
+
+# ---- Step 1: data and pvrd ----
+set data [file join $arg(-out) data]
+file delete -force $data
+file mkdir [file join $data block]
+# Voxel (x,y,z), x fastest: 200 inside the block x 4..13, y 6..27, z 3..20,
+# 120 inside the ball of radius 6 at (22, 20, 22), 0 elsewhere.
+set bytes {}
+for {set z 0} {$z < 32} {incr z} {
+    for {set y 0} {$y < 32} {incr y} {
+        set row {}
+        for {set x 0} {$x < 32} {incr x} {
+            set v 0
+            if {$x >= 4 && $x <= 13 && $y >= 6 && $y <= 27 && $z >= 3 && $z <= 20} {
+                set v 200
+            } elseif {($x - 22) ** 2 + ($y - 20) ** 2 + ($z - 22) ** 2 <= 36} {
+                set v 120
+            }
+            lappend row $v
+        }
+        append bytes [binary format c* $row]
+    }
+}
+set f [open [file join $data block block.raw] wb]
+puts -nonewline $f $bytes
+close $f
+set f [open [file join $data block block.json] w]
+puts $f {{"dims": [32, 32, 32], "dtype": "uint8", "spacing": [1, 1, 1], "origin": [0, 0, 0],
+ "raw_file": "block.raw", "endian": "little", "stats": {"min": 0, "max": 200}}}
+close $f
+
+set env(OMPI_ALLOW_RUN_AS_ROOT) 1
+set env(OMPI_ALLOW_RUN_AS_ROOT_CONFIRM) 1
+# `timeout` ends pvrd even when this script is killed before finish runs.
+set pvrdChan [open |[list timeout --signal=TERM 80 $arg(-pvrd) --listen 127.0.0.1:0 --data-dir $data --node $arg(-node) --max-ranks 2 2>@stderr] r]
+fconfigure $pvrdChan -blocking 0 -buffering line
+set port ""
+proc readPvrd {} {
+    if {[gets $::pvrdChan line] >= 0 && [regexp {listening on 127\.0\.0\.1:(\d+)} $line -> p]} {
+        set ::port $p
+    }
+    if {[eof $::pvrdChan]} {
+        fileevent $::pvrdChan readable {}
+    }
+}
+fileevent $pvrdChan readable readPvrd
+if {![waitFor {$::port ne ""} 10]} {
+    check "pvrd starts" 0 "no 'pvrd listening on' line"
+    finish
+}
+
+# Everything below runs inside one catch: an error fails the test and still
+# stops pvrd (pvrsh stays in the event loop after a script error).
+proc steps {} {
+    uplevel #0 {
+# ---- Step 2: the GUI and its first frame ----
+source [file join $arg(-source) tcl gui.tcl]
+set photo $::pvr::gui::image
+::pvr::gui::main -host 127.0.0.1:$port -ranks 1 -dataset block -imagesz 128x128 -datadir $data
+update
+
+# idle: no request in flight and none waiting.
+proc idle {} {
+    return [expr {!$::pvr::gui::view::busy && !$::pvr::gui::view::dirty}]
+}
+# lit: pixels of the photo brighter than the dark background, in a 16x16 grid.
+proc lit {} {
+    set n 0
+    set w [image width $::photo]
+    set h [image height $::photo]
+    for {set y 4} {$y < $h} {incr y [expr {max(1, $h / 16)}]} {
+        for {set x 4} {$x < $w} {incr x [expr {max(1, $w / 16)}]} {
+            lassign [$::photo get $x $y] r g b
+            if {$r + $g + $b > 60} {
+                incr n
+            }
+        }
+    }
+    return $n
+}
+# pixels: the photo's data, to compare frames.
+proc pixels {} {
+    return [$::photo data -format ppm]
+}
+
+set first [waitFor {$::pvr::gui::view::sent >= 1 && [idle] && [llength [::pvr::gui::stat::frames .stat.c]] >= 1} 30]
+check "connect: the first frame arrives" $first "status: $::pvr::gui::statusText"
+if {!$first} {
+    finish
+}
+check "first frame: 128x128 in the photo" \
+    {[image width $photo] == 128 && [image height $photo] == 128} "[image width $photo]x[image height $photo]"
+set lit0 [lit]
+check "first frame: the volume is visible (lit pixels)" {$lit0 > 5} "lit $lit0"
+set frame0 [pixels]
+
+# ---- Step 3: a drag on the image ----
+set sentBefore $::pvr::gui::view::sent
+set az0 $::pvr::gui::view::azimuth
+set img .view.image
+event generate $img <ButtonPress-1> -x 40 -y 64 -button 1
+for {set i 1} {$i <= 12} {incr i} {
+    event generate $img <B1-Motion> -x [expr {40 + 5 * $i}] -y [expr {64 + $i}] -state 0x100
+}
+event generate $img <ButtonRelease-1> -x 100 -y 76 -button 1 -state 0x100
+check "drag: the azimuth turned 30 degrees" \
+    {abs(fmod($az0 - $::pvr::gui::view::azimuth + 360, 360) - 30) < 1e-6} "azimuth $::pvr::gui::view::azimuth"
+check "drag: the elevation rose 6 degrees (dragging down)" {abs($::pvr::gui::view::elevation - 26) < 1e-6} \
+    "elevation $::pvr::gui::view::elevation"
+waitFor {[idle]} 20
+set requests [expr {$::pvr::gui::view::sent - $sentBefore}]
+check "drag: 12 motion events coalesced into fewer requests" {$requests >= 1 && $requests < 12} "requests $requests"
+set frame1 [pixels]
+check "drag: the image changed" {$frame1 ne $frame0}
+check "drag: the volume is still visible" {[lit] > 5} "lit [lit]"
+
+# ---- Step 4: the turn-right button ----
+set sentBefore $::pvr::gui::view::sent
+set az1 $::pvr::gui::view::azimuth
+set button .ctl.view.right
+event generate $button <Enter>
+event generate $button <ButtonPress-1> -x 5 -y 5 -button 1
+event generate $button <ButtonRelease-1> -x 5 -y 5 -button 1
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+check "button: the azimuth turned 15 degrees" \
+    {abs(fmod($::pvr::gui::view::azimuth - $az1 + 360, 360) - 15) < 1e-6} "azimuth $::pvr::gui::view::azimuth"
+set frame2 [pixels]
+check "button: a new frame with other pixels" {$frame2 ne $frame1}
+
+# ---- Step 5: drag a transfer-function point ----
+set editor .ctl.tf.editor
+set sentBefore $::pvr::gui::view::sent
+set points [::pvr::gui::tfeditor::normalized $editor]
+lassign [::pvr::gui::tfeditor::toCanvas $editor [lindex $points end 0] [lindex $points end 4]] px py
+set px [expr {int($px)}]
+set py [expr {int($py)}]
+event generate $editor <ButtonPress-1> -x $px -y $py -button 1
+event generate $editor <B1-Motion> -x $px -y [expr {$py + 60}] -state 0x100
+event generate $editor <ButtonRelease-1> -x $px -y [expr {$py + 60}] -button 1 -state 0x100
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+set opacity [lindex [::pvr::gui::tfeditor::normalized $editor] end 4]
+check "tf: the last point's opacity went down" {$opacity < [lindex $points end 4]} "opacity $opacity"
+check "tf: the change rendered a new frame" {$::pvr::gui::view::sent > $sentBefore && [pixels] ne $frame2}
+
+# ---- Step 6: a rotation sequence ----
+set ::pvr::gui::opt(axis) 0,0,1
+set ::pvr::gui::opt(range) 0,5:12
+set statFrames [llength [::pvr::gui::stat::frames .stat.c]]
+.ctl.seq.go invoke
+check "sequence: the GUI is busy while it runs" {$::pvr::gui::view::busy}
+waitFor {[idle]} 30
+check "sequence: the progress bar reached 6 of 6" \
+    {$::pvr::gui::progress == 6 && [.bar.progress cget -maximum] == 6} "progress $::pvr::gui::progress"
+check "sequence: six more bars in the performance graph" \
+    {[llength [::pvr::gui::stat::frames .stat.c]] == min(60, $statFrames + 6)}
+check "sequence: the status line reports it" {[string match "sequence done: 6 frames*" $::pvr::gui::statusText]} \
+    $::pvr::gui::statusText
+set timing [lindex [::pvr::gui::stat::frames .stat.c] end 1]
+set phases 0
+foreach k {dist rend comp comm send} {
+    incr phases [dict exists $timing $k]
+}
+check "graph: the frame's timing has the five phases" {$phases == 5} $timing
+
+# ---- Step 7: artifacts ----
+$photo write [file join $arg(-out) gui_frame.png] -format png
+check "artifact: gui_frame.png written" {[file size [file join $arg(-out) gui_frame.png]] > 100}
+update
+if {[auto_execok import] ne ""} {
+    set shot [file join $arg(-out) gui_screenshot.png]
+    if {[catch {exec import -window root $shot} message]} {
+        puts "note: import failed: $message"
+    } else {
+        check "artifact: gui_screenshot.png written" {[file size $shot] > 1000}
+    }
+}
+    }
+}
+if {[catch steps message]} {
+    check "no Tcl error" 0 "$message\n$::errorInfo"
+}
+puts "artifacts in $arg(-out)"
+finish
