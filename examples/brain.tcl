@@ -1,7 +1,8 @@
 # The Figure 5 program of paper 003 (a simple PVR program), changed only in
-# host and dataset names: it runs against a local pvrd.
+# host and dataset names, and scaled from 100 nodes (clusters of 16) to the
+# 8 ranks of one workstation (clusters of 1): it runs against a local pvrd.
 #
-#   pvrd --listen 127.0.0.1:7350 --data-dir /work/shared/data &
+#   pvrd --listen 127.0.0.1:7350 --data-dir /work/shared/data --max-ranks 8 &
 #   pvrsh examples/brain.tcl ?HOST:PORT? ?DATASET?
 #
 # HOST:PORT comes from the first argument, else $PVR_SERVER, else
@@ -35,13 +36,13 @@ if {$tk} {
 }
 :brain image callback imgCallback ; # specifies the external command
 :brain image dir ./           ; # where to place images
-:brain open $host             ; # opens a connection with the server
+:brain open $host -ranks 8    ; # opens a connection with the server (8 ranks: one workstation)
                                 # if this command succeeds, we are connected
 :brain set -dataset $dataset  ; # specifies the dataset
-:brain set -cluster r,16 -group 0,0,1,1 ; # 4 rendering clusters of 16 nodes
+:brain set -cluster r,1 -group 0,0,1,1 ; # 4 rendering clusters of 1 node
                                 # divided into 2 groups, nodes in a group
                                 # share the same image calculation
-:brain set -cluster c -group 0,0 ; # 2 compositing clusters of 15 nodes each
+:brain set -cluster c -group 0,0 ; # 2 compositing clusters sharing the other ranks
 :brain set -imagesz 512,512   ; # specifies the image size
 :brain render rotation 0,1,0 15,59:60 ; # specifies the rendering of 45 images,
                                 # starting from one quarter rotation along the y axis

@@ -167,6 +167,7 @@ void Session::open(const std::string& host, int port, std::uint32_t ranks, const
     ranks_ = r->rankCount;
     layout_ = r->clusters;
     state_ = State::kOpen;
+    layoutPending_ = false;
     // Step 4: what was set before the session opened.
     if (!settings_.dataset.empty() || !settings_.scene.empty())
       send(proto::SetScene{settings_.dataset, settings_.scene.empty() ? std::string() : settings_.scene.dump()}, false);
@@ -197,11 +198,17 @@ void Session::applySettings(const SettingsChange& change) {
     send(proto::SetScene{change.dataset ? settings_.dataset : std::string(),
                          change.patch.empty() ? std::string() : change.patch.dump()},
          false);
-  if (change.layout) send(proto::SetLayout{settings_.clusters}, false);
+  // Figure 5 sets render and compositing clusters in two commands; the
+  // layout goes out whole with the next render, so no half layout is sent.
+  if (change.layout) layoutPending_ = true;
 }
 
 std::uint32_t Session::render(const proto::Message& request, std::uint32_t total, const std::string& label) {
   requireOpen("render");
+  if (layoutPending_) {
+    send(proto::SetLayout{settings_.clusters}, false);
+    layoutPending_ = false;
+  }
   const std::uint32_t id = send(request, false);
   Sequence& seq = sequences_[id];
   seq.id = id;

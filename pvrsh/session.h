@@ -132,6 +132,7 @@ class Session : public Connection::Listener {
   std::optional<TclError> waitError_;             // first error while waiting
   std::optional<TclError> lastFailure_;          // why the connection ended
   std::string closeReason_;                       // the server's Close reason
+  bool layoutPending_ = false;                    // a layout set since open, sent with the next render
   bool deleted_ = false;
 };
 

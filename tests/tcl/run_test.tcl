@@ -8,5 +8,10 @@ proc ::tcltest::cleanupTestsHook {} {
     variable numTests
     set ::failed [expr {$numTests(Failed) > 0}]
 }
-source $file
+if {[catch {source $file} msg]} {
+    puts stderr $msg
+    set failed 1
+}
+# A daemon a failed test file left running is stopped here.
+catch {::pvrtest::stopPvrd}
 exit $failed
