@@ -51,6 +51,8 @@ namespace eval ::pvr::gui {
     variable tfPending 0
     # Whether the session is open (kept here: `list status` asks the server).
     variable connected 0
+    # Errors shown on the status line so far.
+    variable errors 0
 }
 
 foreach file {stat.tcl tfeditor.tcl gui_view.tcl gui_layout.tcl} {
@@ -197,7 +199,7 @@ proc ::pvr::gui::buildMain {} {
 proc ::pvr::gui::buildStat {} {
     toplevel .stat
     wm title .stat "PVR frame times"
-    canvas .stat.c -width 520 -height 200
+    canvas .stat.c -width 600 -height 200
     pack .stat.c -fill both -expand 1
     ::pvr::gui::stat::attach .stat.c
     wm protocol .stat WM_DELETE_WINDOW {wm withdraw .stat}
@@ -220,6 +222,7 @@ proc ::pvr::gui::status {text {kind info}} {
         .bar.status configure -foreground [expr {$kind eq "error" ? "#b00000" : "black"}]
     }
     if {$kind eq "error"} {
+        incr ::pvr::gui::errors
         puts stderr "pvr gui: $text"
     }
 }

@@ -20,6 +20,10 @@ namespace eval ::pvr::gui::layout {
         strategy binary-swap
         decomposition kd
     }
+    # Strategy and decomposition as last sent (the server's defaults at
+    # first): they are sent only when the form differs.
+    variable sent
+    array set sent {strategy binary-swap decomposition kd}
 }
 
 # ::pvr::gui::layout::show --
@@ -82,6 +86,8 @@ proc ::pvr::gui::layout::show {session} {
     pack $w.render $w.comp $w.report -fill x -padx 6 -pady 4
     pack $w.buttons -fill x -padx 6 -pady 6
     wm protocol $w WM_DELETE_WINDOW [list wm withdraw $w]
+    # Beside the main window (a window manager may place it elsewhere).
+    wm geometry $w +[expr {[winfo rootx .] + [winfo width .] + 12}]+[winfo rooty .]
     refresh $session
     return $w
 }
@@ -139,8 +145,14 @@ proc ::pvr::gui::layout::refresh {session} {
 #   Sends the form as -cluster/-group, -strategy and -decomposition settings.
 proc ::pvr::gui::layout::apply {session} {
     variable form
-    set settings [list -cluster r,$form(renderRanks) -group $form(renderGroups) \
-                      -strategy $form(strategy) -decomposition $form(decomposition)]
+    variable sent
+    set settings [list -cluster r,$form(renderRanks) -group $form(renderGroups)]
+    foreach key {strategy decomposition} {
+        if {$form($key) ne $sent($key)} {
+            lappend settings -$key $form($key)
+            set sent($key) $form($key)
+        }
+    }
     if {[catch {
         $session set {*}$settings
         if {$form(composite) eq "separate"} {

@@ -10,7 +10,9 @@
 #      fewer requests, and changes the image;
 #   3. a press of the "turn right" button turns it by 15 degrees, another frame;
 #   4. dragging a transfer-function point renders again, with other pixels;
-#   5. a rotation sequence fills the progress bar and the performance graph.
+#   5. a rotation sequence fills the progress bar and the performance graph;
+#   6. the cluster and group window shows the layout, asks the server for
+#      memory per cluster, and applies the form.
 # Writes DIR/gui_frame.png (the photo) and DIR/gui_screenshot.png (the whole
 # screen, when ImageMagick's import is installed). Exits 0 when all pass, 1
 # otherwise; gives up after 50 s.
@@ -239,7 +241,21 @@ foreach k {dist rend comp comm send} {
 }
 check "graph: the frame's timing has the five phases" {$phases == 5} $timing
 
-# ---- Step 7: artifacts ----
+# ---- Step 7: the cluster and group window ----
+::pvr::gui::layout::show $::pvr::gui::session
+update
+check "layout: the window shows the layout in force" \
+    {[string match "*state open*render*" [.layout.report.t get 1.0 end]]} [.layout.report.t get 1.0 end]
+.layout.report.b.mem invoke
+check "layout: memory per cluster from the server" \
+    {[string match "performance memory cluster:*" [.layout.report.t get 1.0 end]]} [.layout.report.t get 1.0 end]
+set sentBefore $::pvr::gui::view::sent
+.layout.buttons.apply invoke
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+check "layout: apply sets the clusters and renders" \
+    {[string match "frame * in * ms*" $::pvr::gui::statusText]} $::pvr::gui::statusText
+
+# ---- Step 8: artifacts ----
 $photo write [file join $arg(-out) gui_frame.png] -format png
 check "artifact: gui_frame.png written" {[file size [file join $arg(-out) gui_frame.png]] > 100}
 update
@@ -256,5 +272,6 @@ if {[auto_execok import] ne ""} {
 if {[catch steps message]} {
     check "no Tcl error" 0 "$message\n$::errorInfo"
 }
+check "no errors on the status line" {$::pvr::gui::errors == 0} "$::pvr::gui::errors errors"
 puts "artifacts in $arg(-out)"
 finish
