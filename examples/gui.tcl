@@ -4,7 +4,7 @@
 #                          ?-imagesz WxH? ?-datadir DIR?
 #
 # With -host it connects at once (otherwise type the address and press
-# Connect; PVR_HOST sets the default). -dataset picks a catalog entry (a
+# Connect; PVR_SERVER sets the default). -dataset picks a catalog entry (a
 # directory name picks the sidecar inside it). -datadir is pvrd's data
 # directory when this machine can read it: the transfer-function editor then
 # shows the dataset's scalar range and histogram.

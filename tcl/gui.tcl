@@ -82,8 +82,8 @@ proc ::pvr::gui::main {args} {
             set connect 1
         }
     }
-    if {[info exists ::env(PVR_HOST)] && !$connect} {
-        set opt(host) $::env(PVR_HOST)
+    if {[info exists ::env(PVR_SERVER)] && !$connect} {
+        set opt(host) $::env(PVR_SERVER)
     }
     # The GUI shows progress itself; no per-frame lines on stderr.
     set ::pvr::progress 0
