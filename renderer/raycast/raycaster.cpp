@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <vector>
 
 #include "../error.h"
 #include "cast_ray.h"
@@ -118,6 +119,10 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   p.diffuse = float(options.shading.diffuse);
   p.specular = float(options.shading.specular);
   p.shininess = float(options.shading.shininess);
+  std::vector<float> specularTable(kSpecularTableSize);
+  for (int i = 0; i < kSpecularTableSize; ++i)
+    specularTable[i] = float(std::pow(double(i) / (kSpecularTableSize - 1), options.shading.shininess));
+  p.specularTable = specularTable.data();
   const RayFunction cast = pickKernel(brick_.type(), options.shading.enabled, bool(preintegrated_));
   const Vec3 lightWorld = normalize(camera.toWorld(options.shading.lightDirection));
 
