@@ -157,6 +157,7 @@ void rebalanceIfNeeded(NodeState& state) {
   const double total = double(std::accumulate(perRank.begin(), perRank.end(), std::uint64_t(0)));
   const double mean = total / double(cluster.size());
   const double worst = double(*std::max_element(perRank.begin(), perRank.end()));
+  state.imbalance = mean > 0 ? worst / mean : 0;
   if (!(mean > 0) || worst / mean <= state.settings.rebalanceThreshold) return;
 
   // Every rank of the cluster builds the same balanced tree and reads its

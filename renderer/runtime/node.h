@@ -96,6 +96,7 @@ struct NodeState {
   std::unique_ptr<core::BrickRenderer> renderer;
   double pendingDist = 0;  // (re)distribution time not yet charged to a frame
   int rebalances = 0;
+  double imbalance = 0;  // max/mean content per rank at the last transfer-function change (master's cluster)
 
   // The wave in flight.
   std::vector<WaveFrame> wave;

@@ -245,7 +245,8 @@ void Master::handle(const proto::Decoded& frame) {
                                                  {"groups", std::to_string(state_.layout.groups)},
                                                  {"dataset", state_.source ? state_.source->describe() : ""},
                                                  {"frames_rendered", std::to_string(frames_)},
-                                                 {"rebalances", std::to_string(state_.rebalances)}};
+                                                 {"rebalances", std::to_string(state_.rebalances)},
+                                                 {"imbalance", std::to_string(state_.imbalance)}};
             send(proto::StatusReply{entries}, id);
           } else if constexpr (std::is_same_v<T, proto::SetScene>) {
             setScene(m, id);
