@@ -5,6 +5,7 @@
 #pragma once
 
 #include "kernel.h"
+#include "kernel_batch.h"
 
 namespace pvr::core {
 
@@ -102,6 +103,11 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
   }
   const std::int64_t body = std::min(exit, ends.last);
   if (start < body) {
+#ifdef PVR_HAVE_BATCH_KERNEL
+    if constexpr (!kPreintegrated) {
+      if (p.indices32 && runBatched<T, kShaded>(p, ray, start, body, acc, samples)) return true;
+    }
+#endif
     if (runScalar<T, kShaded, kPreintegrated>(p, ray, start, body, acc, samples)) return true;
     start = body;
   }

@@ -88,6 +88,7 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   p.strideY = ext.x;
   p.strideZ = ext.x * ext.y;
   p.base = -(st.lo.x + st.lo.y * p.strideY + st.lo.z * p.strideZ);
+  p.indices32 = st.nodeCount() < (std::int64_t(1) << 31) - 1;
   for (int a = 0; a < 3; ++a) {
     p.ownLo[a] = double(own.lo[a]);
     p.ownHi[a] = double(own.hi[a]);
