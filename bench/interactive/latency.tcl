@@ -1,0 +1,154 @@
+# latency.tcl -- request-to-pixels latency of single frames in a Tk window.
+#
+#   pvrsh latency.tcl -host HOST:PORT ?-frames 50? ?-ranks 2? ?-shading 1?
+#                     ?-preset TF.json? ?-size 512? ?-out DIR? ?-tag latency?
+#
+# A photo in a label on screen receives the frames (`:s image window`). For
+# each of -frames single frames of the CT head (after 3 warm-up frames) it
+# takes the time of `:s render frame` and two arrival times:
+#   photo  when `:s image callback` runs: the pixels are in the photo;
+#   shown  when the event loop next goes idle: Tk has redrawn the label
+#          (its redisplay was queued before ours), so the pixels are on the
+#          window.
+# The view turns 7 degrees between frames (`:s set -eye ...` would need the
+# bounds; `render rotate 0,0,1 K,K:360` is one frame of the automatic
+# camera turned K degrees), so every frame is new pixels; the request is
+# still one frame. Writes DIR/TAG.csv (not -name: Tk takes that one) and prints median and p90.
+
+package require Tk
+
+array set opt {-host "" -frames 50 -ranks 2 -shading 1 -preset "" -size 512 -out . -tag latency
+               -dataset ct_head_cranium/ct_head_cranium.json}
+foreach {k v} $argv {
+    if {![info exists opt($k)]} {
+        puts stderr "latency.tcl: unknown option $k"
+        exit 2
+    }
+    set opt($k) $v
+}
+set ::pvr::progress 0
+set size $opt(-size)
+
+# The window: a photo in a label, as the GUI shows it.
+wm title . "PVR latency"
+image create photo frame -width $size -height $size
+label .l -image frame -borderwidth 0
+pack .l
+update
+
+pvr_session :bench
+:bench image window frame
+:bench image callback onFrame
+:bench notify onNotify
+:bench open $opt(-host) -ranks $opt(-ranks)
+set settings [list -dataset $opt(-dataset) -imagesz $size,$size -shading $opt(-shading)]
+if {$opt(-preset) ne ""} {
+    lappend settings -tfpreset $opt(-preset)
+}
+:bench set {*}$settings
+
+# Per frame: request time, photo time, shown time (microseconds), timing.
+set current {}
+proc onFrame {frame timing} {
+    dict set ::current photo [clock microseconds]
+    dict set ::current timing $timing
+    after idle {
+        dict set ::current shown [clock microseconds]
+        set ::arrived 1
+    }
+}
+proc onNotify {event args} {
+    if {$event eq "error"} {
+        puts stderr "latency.tcl: [lindex $args 0]"
+        exit 1
+    }
+}
+
+# one: a single frame at `degrees`; returns its record.
+proc one {degrees} {
+    set ::current {}
+    set ::arrived 0
+    set start [clock microseconds]
+    if {$degrees % 360 == 0} {
+        :bench render frame
+    } else {
+        :bench render rotate 0,0,1 $degrees,$degrees:360
+    }
+    vwait ::arrived
+    # The request is over when `wait` returns (the notify of its end).
+    :bench wait -timeout 30
+    dict set ::current start $start
+    return $::current
+}
+
+foreach k {0 1 2} {
+    one [expr {$k * 7}]
+}
+lassign [frame get [expr {$size / 2}] [expr {$size / 2}]] r g b
+set records {}
+for {set i 0} {$i < $opt(-frames)} {incr i} {
+    lappend records [one [expr {($i + 3) * 7}]]
+}
+
+# ---- Report ----
+proc percentile {values p} {
+    set sorted [lsort -real $values]
+    set n [llength $sorted]
+    # Nearest rank.
+    set k [expr {max(0, min($n - 1, int(ceil($p * $n)) - 1))}]
+    return [lindex $sorted $k]
+}
+set photo {}
+set shown {}
+set overhead {}
+set phases {dist rend comp comm send}
+foreach p $phases {
+    set sum($p) 0.0
+}
+file mkdir $opt(-out)
+set csv [open [file join $opt(-out) $opt(-tag).csv] w]
+puts $csv "frame,request_to_photo_s,request_to_shown_s,dist_s,rend_s,comp_s,comm_s,send_s"
+set i 0
+foreach rec $records {
+    set tp [expr {([dict get $rec photo] - [dict get $rec start]) / 1e6}]
+    set ts [expr {([dict get $rec shown] - [dict get $rec start]) / 1e6}]
+    lappend photo $tp
+    lappend shown $ts
+    set server 0.0
+    foreach p $phases {
+        set server [expr {$server + [dict get [dict get $rec timing] $p]}]
+    }
+    # What the server's phases do not account for: request and frame on the
+    # wire, queueing, zlib decode, the photo update.
+    lappend overhead [expr {$tp - $server}]
+    set row [list $i [format %.4f $tp] [format %.4f $ts]]
+    foreach p $phases {
+        set v [dict get [dict get $rec timing] $p]
+        set sum($p) [expr {$sum($p) + $v}]
+        lappend row [format %.4f $v]
+    }
+    puts $csv [join $row ,]
+    incr i
+}
+close $csv
+
+set n [llength $records]
+set status [:bench list status]
+set f [open /proc/loadavg]
+set load [lindex [read $f] 0]
+close $f
+puts "PVR interactive latency: $opt(-dataset), ${size}x${size}, $n frames after 3 warm-up,\
+      [dict get $status ranks] ranks, shading $opt(-shading), [exec nproc] cores, load average $load"
+puts [format "request-to-photo  median %.3f s  p90 %.3f s" [percentile $photo 0.5] [percentile $photo 0.9]]
+puts [format "request-to-shown  median %.3f s  p90 %.3f s  (target 0.25 s: %s)" \
+          [percentile $shown 0.5] [percentile $shown 0.9] \
+          [expr {[percentile $shown 0.5] <= 0.25 ? "met" : "missed"}]]
+set parts {}
+foreach p $phases {
+    lappend parts [format "%s %.1f ms" $p [expr {$sum($p) / $n * 1e3}]]
+}
+puts "server phases, mean: [join $parts {  }]"
+puts [format "outside the server's phases (wire, decode, photo): median %.1f ms" [expr {[percentile $overhead 0.5] * 1e3}]]
+puts "centre pixel after warm-up (not background when the head is there): $r $g $b"
+:bench close
+exit 0
