@@ -7,7 +7,8 @@ namespace pvr::runtime::actions {
 
 void reportMemory(NodeState& state, const ActionArgs& args) {
   std::vector<std::uint64_t> bytes(std::size_t(state.world.size()), 0);
-  bytes[std::size_t(state.world.rank())] = state.brick.byteSize();
+  // Ranks without a brick (composite clusters, a dedicated collector) hold none.
+  bytes[std::size_t(state.world.rank())] = state.renderer ? state.brick.byteSize() : 0;
   state.world.allReduceSum(bytes);
   if (state.world.rank() != 0) return;
   const int only = args.value("cluster", -1);
