@@ -60,7 +60,7 @@ void BrickRenderer::classify(const TransferFunctionSpec& tf, const RenderOptions
 }
 
 Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, ThreadPool& pool,
-                            RenderStats* stats) const {
+                            RenderStats* stats, const PixelRect* region) const {
   const auto started = std::chrono::steady_clock::now();
   if (options.step != classifiedStep_ || options.preintegrated != bool(preintegrated_))
     throw Error(ErrorCode::kInternal, "BrickRenderer::render: classify() was called with other options");
@@ -74,8 +74,9 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   const Vec3 lo = grid.nodePosition(own.lo), hi = grid.nodePosition(own.hi);
   bool degenerate = false;
   for (int a = 0; a < 3; ++a) degenerate |= grid.dims[a] < 2;
-  Image image(camera.width(), camera.height(),
-              degenerate ? PixelRect{} : camera.project(lo, hi));
+  PixelRect rect = degenerate ? PixelRect{} : camera.project(lo, hi);
+  if (region) rect = rect.intersect(*region);
+  Image image(camera.width(), camera.height(), rect);
   if (image.rect().empty()) {
     if (stats) *stats = {};
     return image;

@@ -53,10 +53,12 @@ class BrickRenderer {
   // call on every transfer-function, step or skipping change.
   void classify(const TransferFunctionSpec& tf, const RenderOptions& options);
 
-  // Renders the brick's screen rectangle. `options` must match the last
-  // classify() in step and pre-integration.
+  // `options` must match the last classify() in step and pre-integration.
+  // Renders the brick's screen rectangle, or only its part inside `region`
+  // (a band of scanlines, say) when one is given: pixels outside it cost
+  // nothing.
   Image render(const Camera& camera, const RenderOptions& options, ThreadPool& pool,
-               RenderStats* stats = nullptr) const;
+               RenderStats* stats = nullptr, const PixelRect* region = nullptr) const;
 
   const Brick& brick() const { return brick_; }
   const MacrocellGrid& macrocells() const { return macrocells_; }

@@ -31,8 +31,11 @@ void render(NodeState& state, const ActionArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   const int width = state.scene.image.width, height = state.scene.image.height;
   const core::Camera camera(w.camera, width, height);
-  core::Image partial = state.renderer->render(camera, state.renderOptions, *state.pool);
-  w.partial = me.bands > 1 ? cropToRect(partial, bandRect(width, height, me.band, me.bands)) : std::move(partial);
+  // A cluster that shares the frame's scanlines with others casts only the
+  // rays of its own band.
+  const core::PixelRect band = bandRect(width, height, me.band, me.bands);
+  w.partial = state.renderer->render(camera, state.renderOptions, *state.pool, nullptr,
+                                     me.bands > 1 ? &band : nullptr);
   w.rend = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
