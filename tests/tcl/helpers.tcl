@@ -2,7 +2,7 @@
 # temporary data directory, and pvrd started on an ephemeral loopback port.
 #
 # The environment (set by tests/tcl/CMakeLists.txt) names the programs:
-# PVRD, PVR_NODE (pvr-node-server), PVR_RENDER, PVR_TEST_TMP.
+# PVRD, PVR_NODE (pvr-node), PVR_RENDER, PVR_TEST_TMP.
 
 package require tcltest 2
 namespace import ::tcltest::*
