@@ -237,7 +237,12 @@ std::size_t Session::wait(double timeoutSeconds) {
   Tcl_Preserve(this);
   ++waiters_;
   std::size_t frames = 0;
-  const std::uint32_t firstId = sequences_.empty() ? nextId_ : sequences_.begin()->first;
+  // The sequence this wait reports: the oldest in flight, else one that
+  // finished before the wait began (the event loop may have run it to the
+  // end while another session was waited for) and no wait has reported.
+  const std::uint32_t firstId = !sequences_.empty() ? sequences_.begin()->first
+                                : last_.id > waitedId_ ? last_.id
+                                                       : nextId_;
   const auto busy = [&] {
     if (waitError_) return false;
     if (!sequences_.empty()) return true;
@@ -256,7 +261,10 @@ std::size_t Session::wait(double timeoutSeconds) {
   --waiters_;
   std::optional<TclError> error;
   if (waiters_ == 0) std::swap(error, waitError_);
-  if (last_.id >= firstId) frames = last_.frames.size();
+  if (last_.id >= firstId) {
+    frames = last_.frames.size();
+    waitedId_ = last_.id;
+  }
   Tcl_Release(this);
   if (error) throw *error;
   if (!inTime) throw TclError({"PVR", "TIMEOUT"}, "wait: session " + name_ + " still busy after " +

@@ -126,6 +126,7 @@ class Session : public Connection::Listener {
   std::map<std::uint32_t, Sequence> sequences_;   // in flight, by request id
   std::map<std::uint32_t, bool> dropped_;         // cancelled ids whose answers are ignored
   Sequence last_;                                 // the most recent sequence, finished or not
+  std::uint32_t waitedId_ = 0;                    // the last sequence whose count a wait returned
   std::uint64_t framesReceived_ = 0;              // numbers the files of `image dir|file`
   std::uint64_t firstFileNumber_ = 0;             // number of a sequence's first `image file` PNG
   int waiters_ = 0;                               // `wait` calls running
