@@ -49,6 +49,12 @@ std::optional<RankFailure> runLocal(NodeState& state, int index, const ActionArg
 
 }  // namespace
 
+void NodeState::matchPoolToSettings() {
+  if (poolThreads == settings.threads) return;
+  pool = std::make_unique<core::ThreadPool>(settings.threads);
+  poolThreads = settings.threads;
+}
+
 void NodeState::maybeFail(const std::string& action) {
   if (action == failAction && world.rank() == failRank) {
     failAction.clear();

@@ -108,6 +108,8 @@ struct NodeState {
   CompositeLog compositeLog;
   std::unique_ptr<core::ThreadPool> pool = std::make_unique<core::ThreadPool>(1);
   int poolThreads = 1;
+  // Resizes the pool to settings.threads when that changed.
+  void matchPoolToSettings();
 
   // Tests: make `failAction` throw once on world rank `failRank`.
   std::string failAction;

@@ -19,10 +19,7 @@ void loadDataset(NodeState& state, const ActionArgs& args) {
       state.settings = old;
       throw;
     }
-    if (state.poolThreads != state.settings.threads) {
-      state.pool = std::make_unique<core::ThreadPool>(state.settings.threads);
-      state.poolThreads = state.settings.threads;
-    }
+    state.matchPoolToSettings();
   });
   distributeData(state);
 }

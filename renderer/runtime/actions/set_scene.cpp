@@ -20,10 +20,7 @@ void setScene(NodeState& state, const ActionArgs& args) {
       state.settings = old;
       throw;
     }
-    if (state.poolThreads != state.settings.threads) {
-      state.pool = std::make_unique<core::ThreadPool>(state.settings.threads);
-      state.poolThreads = state.settings.threads;
-    }
+    state.matchPoolToSettings();
     classify(state);
   });
   if (redistribute) distributeData(state);
