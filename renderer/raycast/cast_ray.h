@@ -26,7 +26,9 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
     const float x0 = o0 + float(s) * d0, x1 = o1 + float(s) * d1, x2 = o2 + float(s) * d2;
     Rgba c;
     if constexpr (kPreintegrated) {
-      const float back = around(v, p, x0 + d0, x1 + d1, x2 + d2);
+      // Sample s + 1's position by the same formula as every sample's, so a
+      // run that starts at s + 1 reads exactly the value carried here.
+      const float back = around(v, p, o0 + float(s + 1) * d0, o1 + float(s + 1) * d1, o2 + float(s + 1) * d2);
       c = finite<T>(front) && finite<T>(back) ? classify2D(p, front, back) : Rgba{};
       front = back;
     } else {
@@ -148,26 +150,27 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
   std::int64_t done = first;  // next sample not yet composited or skipped
   std::int64_t k = first;
   while (k <= last) {
-    // Which macrocell holds sample k, and where does its run of equally
-    // visible macrocells end?
+    // Which macrocell holds sample k?
     const float u0 = o0 + float(k) * d0, u1 = o1 + float(k) * d1, u2 = o2 + float(k) * d2;
-    int m[3] = {std::clamp(int(u0) >> mcShift, p.mcFirst[0], p.mcFirst[0] + p.mcCount[0] - 1),
-                std::clamp(int(u1) >> mcShift, p.mcFirst[1], p.mcFirst[1] + p.mcCount[1] - 1),
-                std::clamp(int(u2) >> mcShift, p.mcFirst[2], p.mcFirst[2] + p.mcCount[2] - 1)};
-    // Deep in empty space: leap over the macrocells the distance field
-    // proves empty (those within d - 1 of this one, whatever the position
-    // of sample k inside it), then look again.
-    const int distance = p.distance[kernel::macrocellIndex(p, m)];
-    if (distance > 1) {
-      k += std::max<std::int64_t>(1, std::int64_t(double(distance - 1) * ray.leapPerMacrocell));
+    const int m[3] = {std::clamp(int(u0) >> mcShift, p.mcFirst[0], p.mcFirst[0] + p.mcCount[0] - 1),
+                      std::clamp(int(u1) >> mcShift, p.mcFirst[1], p.mcFirst[1] + p.mcCount[1] - 1),
+                      std::clamp(int(u2) >> mcShift, p.mcFirst[2], p.mcFirst[2] + p.mcCount[2] - 1)};
+    const std::size_t cell = kernel::macrocellIndex(p, m);
+    if (!p.visible[cell]) {
+      // Empty space. Deep in it, leap over the macrocells the distance
+      // field proves empty (those within d - 1 of this one, wherever sample
+      // k lies inside it); next to something visible, step out of this
+      // macrocell.
+      const int distance = p.distance[cell];
+      k = distance > 1 ? k + std::max<std::int64_t>(1, std::int64_t(double(distance - 1) * ray.leapPerMacrocell))
+                       : kernel::macrocellExit(ray, m, k, mcShift);
       continue;
     }
-    bool visible;
-    const std::int64_t exit = kernel::runExit(p, ray, m, k, last, mcShift, visible);
-    if (!visible) {
-      k = exit;
-      continue;
-    }
+    // Something visible: sample a fixed chunk and look again. Samples that
+    // run on into an empty macrocell add nothing, and a chunk costs one
+    // look-up where walking the visible macrocells exactly (a 3D DDA)
+    // mispredicted a branch at nearly every macrocell face.
+    const std::int64_t exit = std::min(last + 1, k + kernel::kVisibleChunk);
     // A pre-integrated segment runs from one sample to the next: when the
     // sample before this run was skipped, its segment ends in here.
     std::int64_t start = k;

@@ -348,56 +348,21 @@ inline std::size_t macrocellIndex(const KernelParams& p, const int* m) {
                      (m[0] - p.mcFirst[0]));
 }
 
-// Where the ray leaves the run of visible macrocells that holds sample k,
-// and the first sample at or after that exit (never less than k + 1).
-// `m` is the macrocell of sample k; *visible tells whether it was visible.
-// Walking macrocell to macrocell (a 3D DDA) until the visibility changes
-// turns a long visible stretch into one uninterrupted sample loop.
-inline std::int64_t runExit(const KernelParams& p, const RaySetup& r, const int m[3], std::int64_t k,
-                            std::int64_t last, int shift, bool& visible) {
-  std::int64_t index = std::int64_t(macrocellIndex(p, m));
-  visible = p.visible[index];
-  // Per axis: the sample index at which the ray crosses the next macrocell
-  // face, its increment per macrocell, the step through p.visible, and how
-  // many macrocells remain before the brick's edge.
-  const std::int64_t stride[3] = {1, p.mcCount[0], std::int64_t(p.mcCount[0]) * p.mcCount[1]};
-  double next[3], delta[3];
-  std::int64_t move[3];
-  int remaining[3];
+// Samples taken per look-up while a ray is in visible macrocells: two
+// batches of eight, about one macrocell at half-voxel steps.
+inline constexpr std::int64_t kVisibleChunk = 16;
+
+// The first sample at or after the ray leaves macrocell m (global index),
+// never less than k + 1.
+inline std::int64_t macrocellExit(const RaySetup& r, const int m[3], std::int64_t k, int shift) {
+  double exitK = 1e300;
   for (int a = 0; a < 3; ++a) {
-    const double cellEdge = double(std::int64_t(1) << shift);
-    if (r.step[a] > 0) {
-      next[a] = (double(std::int64_t(m[a] + 1) << shift) - r.origin[a]) * r.invStep[a];
-      delta[a] = cellEdge * r.invStep[a];
-      move[a] = stride[a];
-      remaining[a] = p.mcFirst[a] + p.mcCount[a] - 1 - m[a];
-    } else if (r.step[a] < 0) {
-      next[a] = (double(std::int64_t(m[a]) << shift) - r.origin[a]) * r.invStep[a];
-      delta[a] = -cellEdge * r.invStep[a];
-      move[a] = -stride[a];
-      remaining[a] = m[a] - p.mcFirst[a];
-    } else {
-      next[a] = 1e300;
-      delta[a] = 0;
-      move[a] = 0;
-      remaining[a] = 0;
-    }
+    if (r.step[a] > 0)
+      exitK = std::min(exitK, (double(std::int64_t(m[a] + 1) << shift) - r.origin[a]) * r.invStep[a]);
+    else if (r.step[a] < 0)
+      exitK = std::min(exitK, (double(std::int64_t(m[a]) << shift) - r.origin[a]) * r.invStep[a]);
   }
-  // ceil(x) > last exactly when x > last, for the integer last: the exit
-  // sample is only rounded once, on the way out.
-  const double lastK = double(last);
-  const std::uint8_t want = visible;
-  for (;;) {
-    const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
-    if (next[a] > lastK) return last + 1;
-    if (remaining[a] == 0) break;
-    --remaining[a];
-    index += move[a];
-    if (p.visible[index] != want) break;
-    next[a] += delta[a];
-  }
-  const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
-  return std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(next[a])));
+  return std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(std::min(exitK, 1e18))));
 }
 
 }  // namespace kernel
