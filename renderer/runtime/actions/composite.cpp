@@ -119,6 +119,18 @@ void compositeServed(NodeState& state) {
     core::Image acc(width, height, core::PixelRect{});
     // Traffic this rank received and blended: the work on its critical path.
     composite::CompositeStats stats;
+    // Receives one sub-image and blends it behind what acc holds.
+    auto blendNext = [&](composite::Communicator& from, int rank, int tag) {
+      auto start = Clock::now();
+      SubImage in = receiveSubImage(from, rank, tag, &stats.encodedBytesSent);
+      w.comm += secondsSince(start);
+      stats.messagesSent += 1;
+      stats.pixelsSent += std::uint64_t(in.image.rect().width()) * std::uint64_t(in.image.rect().height());
+      start = Clock::now();
+      if (in.failure && !failure) failure = in.failure;
+      if (!failure) blendOver(acc, in.image);
+      w.comp += secondsSince(start);
+    };
 
     // My run of the visibility order, blended front to back as it arrives.
     auto t = Clock::now();
@@ -128,16 +140,7 @@ void compositeServed(NodeState& state) {
     w.comm += secondsSince(t);
     for (int p = 0; p < n; ++p) {
       if (runOf(p, n, m) != j) continue;
-      t = Clock::now();
-      SubImage in = receiveSubImage(state.world, render.ranks[std::size_t(order[std::size_t(p)])], kPartialTag,
-                                    &stats.encodedBytesSent);
-      w.comm += secondsSince(t);
-      stats.messagesSent += 1;
-      stats.pixelsSent += std::uint64_t(in.image.rect().width()) * std::uint64_t(in.image.rect().height());
-      t = Clock::now();
-      if (in.failure && !failure) failure = in.failure;
-      if (!failure) blendOver(acc, in.image);
-      w.comp += secondsSince(t);
+      blendNext(state.world, render.ranks[std::size_t(order[std::size_t(p)])], kPartialTag);
     }
 
     // Binary tree over the composite ranks: j keeps the front, j + stride
@@ -150,17 +153,7 @@ void compositeServed(NodeState& state) {
         w.comm += secondsSince(t);
         break;
       }
-      if (j % (2 * stride) == 0 && j + stride < m) {
-        t = Clock::now();
-        SubImage in = receiveSubImage(comp, j + stride, kTreeTag, &stats.encodedBytesSent);
-        w.comm += secondsSince(t);
-        stats.messagesSent += 1;
-        stats.pixelsSent += std::uint64_t(in.image.rect().width()) * std::uint64_t(in.image.rect().height());
-        t = Clock::now();
-        if (in.failure && !failure) failure = in.failure;
-        if (!failure) blendOver(acc, in.image);
-        w.comp += secondsSince(t);
-      }
+      if (j % (2 * stride) == 0 && j + stride < m) blendNext(comp, j + stride, kTreeTag);
     }
     state.compositeLog.seconds += w.comp + w.comm;
     state.compositeLog.frames += 1;
