@@ -52,12 +52,12 @@ std::set<pid_t> descendants(pid_t root) {
     ::closedir(d);
   }
   std::set<pid_t> found;
-  std::deque<pid_t> todo{root};
-  while (!todo.empty()) {
-    const pid_t p = todo.front();
-    todo.pop_front();
+  std::deque<pid_t> frontier{root};
+  while (!frontier.empty()) {
+    const pid_t p = frontier.front();
+    frontier.pop_front();
     for (auto [it, end] = children.equal_range(p); it != end; ++it)
-      if (found.insert(it->second).second) todo.push_back(it->second);
+      if (found.insert(it->second).second) frontier.push_back(it->second);
   }
   return found;
 }
