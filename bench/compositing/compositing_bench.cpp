@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "frame.h"
+#include "report.h"
 #include "mpi_communicator.h"
 
 namespace {
@@ -95,15 +96,10 @@ void benchSize(const Args& args, core::Scene scene, int size, composite::Communi
       // The median repetition by composite time.
       std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.composite < b.composite; });
       const Sample& s = samples[samples.size() / 2];
-      std::uint64_t messages = 0, maxMessages = 0, raw = 0, encoded = 0, pixels = 0, gather = 0;
-      for (const auto& r : last.ranks) {
-        messages += r.composite.messagesSent;
-        maxMessages = std::max(maxMessages, r.composite.messagesSent);
-        raw += r.composite.rawBytesSent;
-        encoded += r.composite.encodedBytesSent;
-        pixels += r.composite.pixelsSent;
-        gather += r.composite.gatherBytesSent;
-      }
+      const runtime::TrafficTotals traffic = runtime::sumTraffic(last.ranks);
+      const std::uint64_t messages = traffic.messages, maxMessages = traffic.maxMessagesPerRank,
+                          raw = traffic.rawBytes, encoded = traffic.encodedBytes, pixels = traffic.pixels,
+                          gather = traffic.gatherBytes;
       const std::string name = c.radix != 2 ? std::string(c.strategy) + "-" + std::to_string(c.radix) : c.strategy;
       const double frame = distRend[1] + s.composite;
       std::ofstream out = appendCsv(

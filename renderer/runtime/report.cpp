@@ -34,6 +34,19 @@ const char* decompositionName(Decomposition d) { return d == Decomposition::kKd 
 
 }  // namespace
 
+TrafficTotals sumTraffic(const std::vector<RankReport>& ranks) {
+  TrafficTotals t;
+  for (const RankReport& r : ranks) {
+    t.messages += r.composite.messagesSent;
+    t.maxMessagesPerRank = std::max(t.maxMessagesPerRank, r.composite.messagesSent);
+    t.rawBytes += r.composite.rawBytesSent;
+    t.encodedBytes += r.composite.encodedBytesSent;
+    t.pixels += r.composite.pixelsSent;
+    t.gatherBytes += r.composite.gatherBytesSent;
+  }
+  return t;
+}
+
 std::string formatReport(const FrameResult& result, const FrameOptions& options) {
   const auto& ranks = result.ranks;
   const int n = int(ranks.size());
@@ -51,15 +64,12 @@ std::string formatReport(const FrameResult& result, const FrameOptions& options)
     }
     out += line("%-8s %9.4f %9.4f %9.4f\n", c.name, mx, sum / n, mn);
   }
-  std::uint64_t messages = 0, maxMessages = 0, raw = 0, encoded = 0, pixels = 0, gatherBytes = 0;
+  const TrafficTotals traffic = sumTraffic(ranks);
+  const std::uint64_t messages = traffic.messages, maxMessages = traffic.maxMessagesPerRank,
+                      raw = traffic.rawBytes, encoded = traffic.encodedBytes, pixels = traffic.pixels,
+                      gatherBytes = traffic.gatherBytes;
   std::uint64_t maxBrick = 0, sumBrick = 0;
   for (const RankReport& r : ranks) {
-    messages += r.composite.messagesSent;
-    maxMessages = std::max(maxMessages, r.composite.messagesSent);
-    raw += r.composite.rawBytesSent;
-    encoded += r.composite.encodedBytesSent;
-    pixels += r.composite.pixelsSent;
-    gatherBytes += r.composite.gatherBytesSent;
     maxBrick = std::max(maxBrick, r.brickBytes);
     sumBrick += r.brickBytes;
   }

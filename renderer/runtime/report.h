@@ -4,11 +4,20 @@
 // the same per rank as CSV.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "frame.h"
 
 namespace pvr::runtime {
+
+// Compositing traffic of a frame summed over its ranks.
+struct TrafficTotals {
+  std::uint64_t messages = 0, maxMessagesPerRank = 0;
+  std::uint64_t rawBytes = 0, encodedBytes = 0, pixels = 0, gatherBytes = 0;
+};
+TrafficTotals sumTraffic(const std::vector<RankReport>& ranks);
 
 std::string formatReport(const FrameResult& result, const FrameOptions& options);
 // One row per rank; throws pvr::Error naming the path if it cannot write.
