@@ -1,32 +1,46 @@
 #!/usr/bin/env bash
-# The dependency rules of ARCHITECTURE.md, checked by grep over the sources:
-#   MPI only in the MPI communicator and the runtime (the MPI program);
-#   Tcl/Tk only in pvrsh/; sockets only where a process talks TCP (protocol
-#   I/O helpers, pvrd, pvrsh, the runtime master's link to its handler, tests).
+# The dependency rules of ../shared/ARCHITECTURE.md, checked over the sources
+# (ctest: "architecture: dependency rules hold"):
+#   - mpi.h in exactly one file, renderer/comm/mpi_communicator.cpp;
+#   - Tcl/Tk only in pvrsh/;
+#   - sockets only where a process talks TCP: pvrd/, pvrsh/, the node's
+#     bridge to pvrd (node/pvrd_link*), and the scaling bench, which plays
+#     the session handler;
+#   - renderer/ includes nothing of protocol/, node/, pvrd/ or pvrsh/, and
+#     protocol/ nothing of the others;
+#   - pvrsh/ and pvrd/ include nothing of renderer/ or node/.
 set -u
 root=${1:-$(dirname "$0")/..}
 cd "$root" || exit 2
 status=0
+sources="renderer protocol node pvrd pvrsh tools bench fuzz"
 
-offenders() {  # pattern, allowed-path regex
-  grep -rlE "$1" --include=*.cpp --include=*.h --include=*.hpp \
-      renderer protocol pvrd pvrsh tools bench 2>/dev/null | grep -vE "$2" || true
+offenders() {  # pattern, allowed-path regex, dirs
+  grep -rlE "$1" --include=*.cpp --include=*.h --include=*.hpp $3 2>/dev/null | grep -vE "$2" || true
 }
 
-check() {  # what, pattern, allowed
+check() {  # what, pattern, allowed, dirs
   local bad
-  bad=$(offenders "$2" "$3")
+  bad=$(offenders "$2" "$3" "${4:-$sources}")
   if [ -n "$bad" ]; then
-    echo "FAIL: $1 outside its place:"; echo "$bad" | sed 's/^/  /'
+    echo "FAIL: $1:"; echo "$bad" | sed 's/^/  /'
     status=1
   else
     echo "ok: $1"
   fi
 }
 
-check "MPI" '#include *<mpi\.h>' '^renderer/(runtime/|composite/mpi_communicator)'
-check "Tcl/Tk" '#include *<(tcl|tk)\.h>' '^pvrsh/'
-check "sockets" '#include *<(sys/socket|netinet/in|arpa/inet)\.h>' '^(protocol/|pvrd/|pvrsh/|renderer/runtime/)'
-check "the protocol codec's purity (no MPI, Tcl or sockets)" \
-  '#include *<(mpi|tcl|tk|sys/socket|netinet/in)\.h>' '^(renderer/|pvrd/|pvrsh/|tools/|bench/)'
+# Headers of a folder, by name, for the include checks below.
+headers_of() { (cd "$1" && find . -name '*.h' | sed 's|^\./||' | sort -u | sed 's/\./\\./g' | paste -sd'|'); }
+
+check "mpi.h only in renderer/comm/mpi_communicator.cpp" '#include *<mpi\.h>' '^renderer/comm/mpi_communicator\.cpp$'
+check "Tcl/Tk only in pvrsh/" '#include *<(tcl|tk)\.h>' '^pvrsh/'
+check "sockets only in pvrd/, pvrsh/, the node's link to pvrd and the scaling bench" \
+  '#include *<(sys/socket|netinet/in|netinet/tcp|arpa/inet|netdb)\.h>' '^(pvrd/|pvrsh/|node/pvrd_link|bench/scaling/)'
+check "renderer/ includes nothing of protocol/ or node/" \
+  "#include *\"($(headers_of protocol)|$(headers_of node))\"" '^$' renderer
+check "protocol/ includes nothing of renderer/ or node/" \
+  "#include *\"($(headers_of renderer | sed 's/|comm[^|]*//g')|$(headers_of node))\"" '^$' protocol
+check "pvrd/ and pvrsh/ include nothing of renderer/ or node/" \
+  "#include *\"($(headers_of node)|raycast/[^\"]*|scene\\.h|brick\\.h|communicator\\.h|strategy\\.h)\"" '^$' "pvrd pvrsh"
 exit $status

@@ -53,7 +53,7 @@ std::ofstream appendCsv(const std::string& path, const char* header) {
   return out;
 }
 
-double maxOver(const std::vector<runtime::RankReport>& ranks, double (*f)(const runtime::RankReport&)) {
+double maxOver(const std::vector<node::RankReport>& ranks, double (*f)(const node::RankReport&)) {
   double m = 0;
   for (const auto& r : ranks) m = std::max(m, f(r));
   return m;
@@ -63,10 +63,10 @@ struct Sample {
   double composite = 0, comp = 0, comm = 0, send = 0;
 };
 
-void benchSize(const Args& args, core::Scene scene, int size, composite::Communicator& comm) {
+void benchSize(const Args& args, core::Scene scene, int size, comm::Communicator& comm) {
   scene.image.width = scene.image.height = size;
-  runtime::FrameOptions options;
-  const runtime::PreparedFrame prepared = runtime::prepareFrame(scene, options, comm);
+  node::FrameOptions options;
+  const node::PreparedFrame prepared = node::prepareFrame(scene, options, comm);
   std::vector<double> distRend{prepared.report.dist, prepared.report.rend};  // max over ranks
   comm.allReduceMax(distRend);
 
@@ -81,22 +81,22 @@ void benchSize(const Args& args, core::Scene scene, int size, composite::Communi
       options.strategyParams.radix = c.radix;
       options.codec = codec;
       std::vector<Sample> samples;
-      runtime::FrameResult last;
+      node::FrameResult last;
       for (int k = 0; k < args.repeat; ++k) {
         comm.barrier();
-        last = runtime::compositeFrame(prepared, options, comm);
+        last = node::compositeFrame(prepared, options, comm);
         Sample s;
-        s.composite = maxOver(last.ranks, [](const runtime::RankReport& r) { return r.comp + r.comm + r.send; });
-        s.comp = maxOver(last.ranks, [](const runtime::RankReport& r) { return r.comp; });
-        s.comm = maxOver(last.ranks, [](const runtime::RankReport& r) { return r.comm; });
-        s.send = maxOver(last.ranks, [](const runtime::RankReport& r) { return r.send; });
+        s.composite = maxOver(last.ranks, [](const node::RankReport& r) { return r.comp + r.comm + r.send; });
+        s.comp = maxOver(last.ranks, [](const node::RankReport& r) { return r.comp; });
+        s.comm = maxOver(last.ranks, [](const node::RankReport& r) { return r.comm; });
+        s.send = maxOver(last.ranks, [](const node::RankReport& r) { return r.send; });
         samples.push_back(s);
       }
       if (comm.rank() != 0) continue;
       // The median repetition by composite time.
       std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.composite < b.composite; });
       const Sample& s = samples[samples.size() / 2];
-      const runtime::TrafficTotals traffic = runtime::sumTraffic(last.ranks);
+      const node::TrafficTotals traffic = node::sumTraffic(last.ranks);
       const std::uint64_t messages = traffic.messages, maxMessages = traffic.maxMessagesPerRank,
                           raw = traffic.rawBytes, encoded = traffic.encodedBytes, pixels = traffic.pixels,
                           gather = traffic.gatherBytes;
@@ -120,12 +120,12 @@ void benchSize(const Args& args, core::Scene scene, int size, composite::Communi
 }
 
 // Voxel bytes per rank against (1/n) of the volume, for both decompositions.
-void benchMemory(const Args& args, core::Scene scene, composite::Communicator& comm) {
+void benchMemory(const Args& args, core::Scene scene, comm::Communicator& comm) {
   scene.image.width = scene.image.height = 64;  // the rendering is not the point here
-  for (auto decomposition : {runtime::Decomposition::kKd, runtime::Decomposition::kBalanced}) {
-    runtime::FrameOptions options;
+  for (auto decomposition : {node::Decomposition::kKd, node::Decomposition::kBalanced}) {
+    node::FrameOptions options;
     options.decomposition = decomposition;
-    const runtime::FrameResult r = runtime::renderFrame(scene, options, comm);
+    const node::FrameResult r = node::renderFrame(scene, options, comm);
     if (comm.rank() != 0) continue;
     std::uint64_t mx = 0, mn = ~0ull, sum = 0;
     for (const auto& rank : r.ranks) {
@@ -137,7 +137,7 @@ void benchMemory(const Args& args, core::Scene scene, composite::Communicator& c
     std::ofstream out = appendCsv(args.memoryCsv,
                                   "ranks,decomposition,max_brick_bytes,mean_brick_bytes,min_brick_bytes,"
                                   "volume_bytes,volume_over_n,ghost_layers,max_over_share");
-    out << comm.size() << ',' << (decomposition == runtime::Decomposition::kKd ? "kd" : "balanced") << ','
+    out << comm.size() << ',' << (decomposition == node::Decomposition::kKd ? "kd" : "balanced") << ','
         << mx << ',' << sum / n << ',' << mn << ',' << r.volumeBytes << ',' << r.volumeBytes / n << ','
         << r.ghostLayers << ',' << mx / (r.volumeBytes / n) << '\n';
   }
@@ -146,12 +146,12 @@ void benchMemory(const Args& args, core::Scene scene, composite::Communicator& c
 }  // namespace
 
 int main(int argc, char** argv) {
-  composite::MpiEnvironment mpi(&argc, &argv);
-  composite::Communicator& comm = mpi.world();
+  comm::MpiEnvironment mpi(&argc, &argv);
+  comm::Communicator& comm = mpi.world();
   try {
     const Args args = parseArgs(argc, argv);
     core::Scene scene;
-    composite::runAgreed(comm, [&] { scene = core::loadSceneFile(args.scene); });
+    comm::runAgreed(comm, [&] { scene = core::loadSceneFile(args.scene); });
     for (int size : args.sizes) benchSize(args, scene, size, comm);
     if (!args.memoryCsv.empty()) benchMemory(args, scene, comm);
     return 0;

@@ -2,7 +2,7 @@
 //
 // A BenchScene is one scene document resolved at its own image size with its
 // volume in memory. Its reference is the same scene integrated by
-// tests/core/reference.h (double precision, substep dt far below any step the
+// tests/renderer/reference.h (double precision, substep dt far below any step the
 // sweep uses), rendered at a reduced "error size" so that it stays
 // affordable; every test image compared with it is rendered at that same
 // size, while frame times are measured at the scene's own size. References

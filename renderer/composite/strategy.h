@@ -27,6 +27,11 @@
 
 namespace pvr::composite {
 
+// Strategies speak only the communicator interface (renderer/comm).
+using comm::Bytes;
+using comm::Communicator;
+using comm::Outgoing;
+
 enum class FinalImage {
   kGatherAtRoot,  // the root receives every tile and returns the whole frame
   kTiles,         // each rank returns its tile; nothing is gathered

@@ -1,0 +1,207 @@
+// composite: the sub-images of the wave rendered by `render` become one
+// band per render cluster at the collector (world rank 0).
+//
+//   - a render cluster without a composite cluster composites itself with
+//     the session's strategy (binary-swap by default) on its cluster
+//     communicator; its rank 0 sends the band to the collector;
+//   - a render cluster served by a composite cluster of m ranks: its rank 0
+//     sends the frame's visibility order to the composite ranks; render
+//     rank at position p of that order sends its sub-image to composite
+//     rank floor(p*m/n) (contiguous runs of the order); each composite rank
+//     blends its run front to back as the images arrive, then the
+//     composite ranks reduce in a binary tree (rank j takes j + stride,
+//     front over back, since runs are in order); their rank 0 sends the band.
+//   - the collector receives every band of every frame of the wave, in
+//     frame and band order.
+// Every rank that someone waits for always sends: an image or the failure
+// that stopped it, so a failure anywhere reaches the collector and nobody
+// deadlocks; the dispatcher's agreement then reports it.
+#include <chrono>
+#include <cstring>
+
+#include "../node.h"
+#include "../wave_io.h"
+
+namespace pvr::node::actions {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// A finished band: kept if this is the collector, else sent to it.
+void deliver(NodeState& state, int slot, int band, const SubImage& message, double& comm) {
+  if (state.world.rank() == 0) {
+    if (message.failure && !state.bandFailure) state.bandFailure = message.failure;
+    if (!message.failure) state.bands[{slot, band}] = message.image;
+    return;
+  }
+  const auto t = Clock::now();
+  sendSubImage(state.world, 0, kBandTag, message, state.settings.codec);
+  comm += secondsSince(t);
+}
+
+int runOf(int position, int n, int m) {
+  // Run j holds positions [j*n/m, (j+1)*n/m).
+  int j = 0;
+  while (j + 1 < m && (long long)(j + 1) * n / m <= position) ++j;
+  return j;
+}
+
+void compositeSelf(NodeState& state, int slot, WaveFrame& w) {
+  const ClusterPlan& me = *state.myCluster();
+  comm::SubCommunicator& cluster = *state.clusterComm;
+  const int width = state.scene.image.width, height = state.scene.image.height;
+  std::optional<comm::Failure> failure;
+  composite::CompositeResult result;
+  try {
+    const core::Camera camera(w.camera, width, height);
+    const auto strategy = composite::makeStrategy(state.settings.strategy);
+    composite::CompositeOptions options;
+    options.codec = state.settings.codec;
+    // Strategies want full-frame partials; the band crop keeps them sparse.
+    result = strategy->composite(w.partial, *state.tree, camera, cluster, options);
+  } catch (...) {
+    failure = comm::failureOf(std::current_exception(), state.world.rank());
+  }
+  failure = cluster.agree(failure);
+  w.comp += result.stats.computeSeconds;
+  w.comm += result.stats.communicationSeconds + result.stats.gatherSeconds;
+  state.compositeLog.seconds += result.stats.computeSeconds + result.stats.communicationSeconds;
+  state.compositeLog.frames += 1;
+  state.compositeLog.last = result.stats;
+  if (cluster.rank() != 0) return;
+  SubImage band{failure, {}};
+  if (!failure) band.image = cropToRect(result.image, bandRect(width, height, me.band, me.bands));
+  deliver(state, slot, me.band, band, w.comm);
+}
+
+void sendToCompositors(NodeState& state, WaveFrame& w) {
+  const ClusterPlan& me = *state.myCluster();
+  const ClusterPlan& comp = state.layout.clusters[std::size_t(me.compositor)];
+  comm::SubCommunicator& cluster = *state.clusterComm;
+  const int n = cluster.size(), m = int(comp.ranks.size());
+  const auto t = Clock::now();
+  // The order is a pure function of the tree and camera: no failure here
+  // that the other ranks would not share.
+  const core::Camera camera(w.camera, state.scene.image.width, state.scene.image.height);
+  const std::vector<int> order = state.tree->visibilityOrder(camera);
+  if (cluster.rank() == 0) {
+    std::vector<std::int32_t> wire(order.begin(), order.end());
+    const auto bytes = std::as_bytes(std::span(wire));
+    for (int r : comp.ranks) state.world.send(r, kOrderTag, bytes);
+  }
+  int position = 0;
+  while (order[std::size_t(position)] != cluster.rank()) ++position;
+  std::uint64_t sent = 0;
+  sendSubImage(state.world, comp.ranks[std::size_t(runOf(position, n, m))], kPartialTag, {std::nullopt, w.partial},
+               state.settings.codec, &sent);
+  w.comm += secondsSince(t);
+  state.compositeLog.last = {};
+  state.compositeLog.last.messagesSent = 1;
+  state.compositeLog.last.encodedBytesSent = sent;
+}
+
+void compositeServed(NodeState& state) {
+  const ClusterPlan& me = *state.myCluster();
+  comm::SubCommunicator& comp = *state.clusterComm;
+  const int j = comp.rank(), m = comp.size();
+  const int width = state.scene.image.width, height = state.scene.image.height;
+  for (int s : me.serves) {
+    const ClusterPlan& render = state.layout.clusters[std::size_t(s)];
+    if (render.group >= int(state.wave.size())) continue;
+    const int slot = render.group;
+    WaveFrame& w = state.wave[std::size_t(slot)];
+    w.mine = true;
+    const int n = int(render.ranks.size());
+    std::optional<comm::Failure> failure;
+    core::Image acc(width, height, core::PixelRect{});
+    // Traffic this rank received and blended: the work on its critical path.
+    composite::CompositeStats stats;
+    // Receives one sub-image and blends it behind what acc holds.
+    auto blendNext = [&](comm::Communicator& from, int rank, int tag) {
+      auto start = Clock::now();
+      SubImage in = receiveSubImage(from, rank, tag, &stats.encodedBytesSent);
+      w.comm += secondsSince(start);
+      stats.messagesSent += 1;
+      stats.pixelsSent += std::uint64_t(in.image.rect().width()) * std::uint64_t(in.image.rect().height());
+      start = Clock::now();
+      if (in.failure && !failure) failure = in.failure;
+      if (!failure) blendOver(acc, in.image);
+      w.comp += secondsSince(start);
+    };
+
+    // My run of the visibility order, blended front to back as it arrives.
+    auto t = Clock::now();
+    const comm::Bytes orderBytes = state.world.receive(render.ranks[0], kOrderTag);
+    std::vector<std::int32_t> order(orderBytes.size() / sizeof(std::int32_t));
+    std::memcpy(order.data(), orderBytes.data(), order.size() * sizeof(std::int32_t));
+    w.comm += secondsSince(t);
+    for (int p = 0; p < n; ++p) {
+      if (runOf(p, n, m) != j) continue;
+      blendNext(state.world, render.ranks[std::size_t(order[std::size_t(p)])], kPartialTag);
+    }
+
+    // Binary tree over the composite ranks: j keeps the front, j + stride
+    // sends its (back) result and is done.
+    for (int stride = 1; stride < m; stride *= 2) {
+      if (j % (2 * stride) == stride) {
+        t = Clock::now();
+        std::uint64_t sent = 0;
+        sendSubImage(comp, j - stride, kTreeTag, {failure, failure ? core::Image() : acc}, state.settings.codec, &sent);
+        w.comm += secondsSince(t);
+        break;
+      }
+      if (j % (2 * stride) == 0 && j + stride < m) blendNext(comp, j + stride, kTreeTag);
+    }
+    state.compositeLog.seconds += w.comp + w.comm;
+    state.compositeLog.frames += 1;
+    state.compositeLog.last = stats;
+    if (j == 0) {
+      SubImage band{failure, {}};
+      if (!failure) band.image = cropToRect(acc, bandRect(width, height, render.band, render.bands));
+      deliver(state, slot, render.band, band, w.comm);
+    }
+  }
+}
+
+// The collector takes every band of the wave from whoever finished it.
+void receiveBands(NodeState& state) {
+  for (int slot = 0; slot < int(state.wave.size()); ++slot) {
+    for (int c : state.layout.renderClustersOf(slot)) {
+      const ClusterPlan& render = state.layout.clusters[std::size_t(c)];
+      const int sender = render.compositor < 0 ? render.ranks[0]
+                                               : state.layout.clusters[std::size_t(render.compositor)].ranks[0];
+      if (sender == 0) continue;  // delivered locally
+      SubImage in = receiveSubImage(state.world, sender, kBandTag);
+      if (in.failure && !state.bandFailure) state.bandFailure = in.failure;
+      if (!in.failure) state.bands[{slot, render.band}] = std::move(in.image);
+    }
+  }
+}
+
+}  // namespace
+
+void composite(NodeState& state, const ActionArgs&) {
+  state.bands.clear();
+  state.bandFailure.reset();
+  const ClusterPlan* me = state.myCluster();
+  std::optional<comm::Failure> local;
+  try {
+    if (me && me->role == proto::ClusterRole::kRender && me->group < int(state.wave.size())) {
+      WaveFrame& w = state.wave[std::size_t(me->group)];
+      if (me->compositor < 0) compositeSelf(state, me->group, w);
+      else sendToCompositors(state, w);
+    } else if (me && me->role == proto::ClusterRole::kComposite) {
+      compositeServed(state);
+    }
+  } catch (...) {
+    local = comm::failureOf(std::current_exception(), state.world.rank());
+  }
+  if (state.world.rank() == 0) receiveBands(state);
+  if (local) throw comm::FailureError(*local);
+  if (state.bandFailure) throw comm::FailureError(*state.bandFailure);
+}
+
+}  // namespace pvr::node::actions

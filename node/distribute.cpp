@@ -1,0 +1,98 @@
+#include "distribute.h"
+
+#include <cstring>
+#include <optional>
+
+#include "decompose/content.h"
+#include "transfer.h"
+
+namespace pvr::node {
+
+using comm::Communicator;
+using comm::runAgreed;
+using core::Brick;
+using core::KdTree;
+
+namespace {
+
+constexpr int kBrickTag = 20;
+constexpr core::SplitAxisRule kAxisRule = core::SplitAxisRule::kAlternating;
+
+// Reads or receives this rank's brick of `tree`. With a partial reader each
+// rank reads its own; otherwise `whole` (rank 0's copy of the volume) is cut
+// and sent.
+Brick obtainBrick(const core::VolumeSource& source, const KdTree& tree, int ghostLayers,
+                  const std::optional<Brick>& whole, Communicator& comm) {
+  const int me = comm.rank();
+  const core::NodeBox owned = tree.ownedBox(me);
+  const core::NodeBox stored = core::storedBox(tree, me, ghostLayers);
+  if (source.canReadPartially()) {
+    Brick brick;
+    runAgreed(comm, [&] { brick = source.readBox(owned, stored); });
+    return brick;
+  }
+  // Scatter from rank 0: it sends every other rank its crop, one at a time;
+  // each receiver waits for exactly one message, so nobody can deadlock.
+  Brick brick;
+  if (me == 0) {
+    for (int r = 1; r < comm.size(); ++r) {
+      const Brick crop = core::cropBrick(*whole, tree.ownedBox(r), ghostLayers);
+      comm.send(r, kBrickTag, std::span<const std::byte>(crop.bytes(), crop.byteSize()));
+    }
+    brick = core::cropBrick(*whole, owned, ghostLayers);
+  } else {
+    const comm::Bytes bytes = comm.receive(0, kBrickTag);
+    runAgreed(comm, [&] {
+      brick = Brick(source.grid(), source.type(), owned, stored);
+      if (bytes.size() != brick.byteSize())
+        throw Error(ErrorCode::kInternal, "scatter: brick " + core::toString(stored) + " came with " +
+                                              std::to_string(bytes.size()) + " bytes, expected " +
+                                              std::to_string(brick.byteSize()));
+      std::memcpy(brick.bytes(), bytes.data(), bytes.size());
+      brick.updateValueRange();
+    });
+    return brick;
+  }
+  runAgreed(comm, [] {});  // rank 0's half of the receivers' agreement
+  return brick;
+}
+
+}  // namespace
+
+Distribution distributeBricks(const core::VolumeSource& source, const core::Scene& scene,
+                              Decomposition decomposition, int ghostLayers, Communicator& comm) {
+  Distribution out;
+  out.readPartially = source.canReadPartially();
+
+  // The k-d tree: the same on every rank (it depends only on the grid).
+  std::optional<KdTree> tree;
+  runAgreed(comm, [&] { tree = KdTree::build(source.grid(), comm.size(), kAxisRule); });
+
+  // Without a partial reader rank 0 holds the whole volume while it scatters.
+  std::optional<Brick> whole;
+  if (!out.readPartially) {
+    runAgreed(comm, [&] {
+      if (comm.rank() == 0) whole = source.readAll();
+    });
+    if (whole) out.rootReadBytes = whole->byteSize();
+  }
+  out.brick = obtainBrick(source, *tree, ghostLayers, whole, comm);
+
+  if (decomposition == Decomposition::kBalanced) {
+    // Count what the transfer function shows in my brick; sum over ranks;
+    // every rank builds the same balanced tree and fetches its new brick.
+    core::ContentGrid content;
+    runAgreed(comm, [&] {
+      const core::TransferTable table(scene.transfer, scene.sampling.step);
+      content = core::countContent(out.brick, table);
+    });
+    comm.allReduceSum(content.counts);
+    runAgreed(comm, [&] { tree = KdTree::buildBalanced(source.grid(), comm.size(), kAxisRule, content); });
+    out.brick = Brick();  // release the first brick before reading the second
+    out.brick = obtainBrick(source, *tree, ghostLayers, whole, comm);
+  }
+  out.tree = std::move(*tree);
+  return out;
+}
+
+}  // namespace pvr::node

@@ -1,0 +1,42 @@
+// Getting each rank its brick: the decomposition (k-d or content-balanced)
+// and the data distribution phase ("dist" of the binary-swap paper's
+// Table 1).
+//
+// When the volume's format reads a box without reading the rest
+// (VolumeSource::canReadPartially), every rank reads only its own brick plus
+// ghost layers. Otherwise rank 0 reads the volume once and sends each rank
+// its brick. Every step that can fail on one rank is followed by an
+// agreement, so all ranks fail together with the first failure's message.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "brick.h"
+#include "communicator.h"
+#include "decompose/kd_tree.h"
+#include "io/volume_io.h"
+#include "scene.h"
+
+namespace pvr::node {
+
+enum class Decomposition {
+  kKd,        // equal cells per rank
+  kBalanced,  // equal non-empty content per rank (decompose/content.h)
+};
+
+struct Distribution {
+  core::KdTree tree;
+  core::Brick brick;             // this rank's owned box plus ghosts
+  bool readPartially = false;    // each rank read its own brick (else rank 0 scattered)
+  std::uint64_t rootReadBytes = 0;  // bytes rank 0 held at once while scattering (0 if none)
+};
+
+// Collective: every rank calls with the same arguments. `scene` must be
+// resolved (resolveDefaults) for `source`'s grid; it supplies the transfer
+// function and step for content balancing.
+Distribution distributeBricks(const core::VolumeSource& source, const core::Scene& scene,
+                              Decomposition decomposition, int ghostLayers,
+                              comm::Communicator& comm);
+
+}  // namespace pvr::node

@@ -1,0 +1,142 @@
+// What every rank of a pvr-node server holds between actions: its place in
+// the layout, the dataset brick, the resolved scene, the frames of the
+// wave in flight. Actions (actions/*.cpp) read and change it; the master
+// also holds the connection's sink for finished frames.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "brick.h"
+#include "camera.h"
+#include "command_channel.h"
+#include "communicator.h"
+#include "decompose/kd_tree.h"
+#include "distribute.h"
+#include "image.h"
+#include "image_codec.h"
+#include "io/volume_io.h"
+#include "layout.h"
+#include "pvr_protocol.h"
+#include "raycast/raycaster.h"
+#include "scene.h"
+#include "strategy.h"
+#include "sub_communicator.h"
+#include "thread_pool.h"
+
+namespace pvr::node {
+
+// Session settings a client sets through the "runtime" object of a
+// SetScene document (docs/runtime.md); the same on every rank.
+struct RuntimeSettings {
+  std::string strategy = "binary-swap";  // self-compositing clusters
+  Decomposition decomposition = Decomposition::kKd;
+  double rebalanceThreshold = 1.2;  // max/mean content per rank that triggers a rebalance
+  proto::PixelFormat format = proto::PixelFormat::kRgba8;
+  proto::Compression compression = proto::Compression::kZlib;
+  core::ImageCodec codec = core::ImageCodec::kAuto;  // sub-images between ranks
+  int threads = 1;                                   // render threads per rank
+};
+
+// One frame of the wave in flight, as this rank sees it.
+struct WaveFrame {
+  int frame = 0;  // position in the request
+  core::CameraSpec camera;
+  core::Image partial;  // render ranks: this rank's brick, cut to its band
+  bool mine = false;    // this rank renders or composites it
+  double rend = 0, comp = 0, comm = 0;
+};
+
+// Compositing measured per cluster, for "performance comp".
+struct CompositeLog {
+  double seconds = 0;  // sum over frames of this rank's comp + comm
+  int frames = 0;
+  composite::CompositeStats last;  // the last frame's traffic
+};
+
+// Ping-pong and blending rates measured at session start (action calibrate).
+struct Calibration {
+  double latency = 0;        // seconds per message, one way
+  double bandwidth = 0;      // bytes per second
+  double blendRate = 0;      // pixels "over" per second
+  bool measured = false;
+};
+
+struct NodeState {
+  NodeState(comm::Communicator& worldComm, comm::CommandChannel& commandChannel, std::string dataDirectory)
+      : world(worldComm), commands(commandChannel), dataDir(std::move(dataDirectory)) {}
+
+  comm::Communicator& world;
+  comm::CommandChannel& commands;  // the master's commands to the slaves
+  std::string dataDir;  // real path; datasets resolve inside it
+  bool running = true;
+
+  // Layout.
+  Layout layout;
+  int cluster = -1;  // my cluster index; -1 for a dedicated master
+  std::unique_ptr<comm::SubCommunicator> clusterComm;
+  const ClusterPlan* myCluster() const { return cluster < 0 ? nullptr : &layout.clusters[std::size_t(cluster)]; }
+  bool renders() const { return myCluster() && myCluster()->role == proto::ClusterRole::kRender; }
+
+  // Scene and data.
+  RuntimeSettings settings;
+  nlohmann::json sceneDoc = nlohmann::json::object();  // without "runtime"
+  std::string volumeKey;  // what the source was opened from
+  std::unique_ptr<core::VolumeSource> source;
+  core::Scene scene;  // resolved for source's grid
+  core::RenderOptions renderOptions;
+  int ghost = 0;
+  std::optional<core::KdTree> tree;  // over my cluster's ranks
+  core::Brick brick;
+  std::unique_ptr<core::BrickRenderer> renderer;
+  double pendingDist = 0;  // (re)distribution time not yet charged to a frame
+  int rebalances = 0;
+  double imbalance = 0;  // max/mean content per rank at the last transfer-function change (master's cluster)
+
+  // The wave in flight.
+  std::vector<WaveFrame> wave;
+  // Collector: finished bands of the wave, by (wave slot, band).
+  std::map<std::pair<int, int>, core::Image> bands;
+  std::optional<comm::Failure> bandFailure;  // the first failure a band brought
+
+  Calibration calibration;
+  CompositeLog compositeLog;
+  std::unique_ptr<core::ThreadPool> pool = std::make_unique<core::ThreadPool>(1);
+  int poolThreads = 1;
+  // Resizes the pool to settings.threads when that changed.
+  void matchPoolToSettings();
+
+  // Tests: make `failAction` throw once on world rank `failRank`.
+  std::string failAction;
+  int failRank = -1;
+  void maybeFail(const std::string& action);
+
+  // Master only: what the last action answered (memory, latency reports).
+  nlohmann::json reply;
+  // Master only: where the collector's finished frames go, and a float
+  // copy for exact comparison when dumpDir is set.
+  std::function<void(proto::ImageFrame&&, bool final)> sendFrame;
+  std::string dumpDir;
+};
+
+using ActionArgs = nlohmann::json;
+using ActionFn = void (*)(NodeState&, const ActionArgs&);
+
+struct ActionEntry {
+  std::string_view name;
+  ActionFn run;
+};
+
+// The action table (actions/table.cpp): every rank runs what the master
+// names; the table's hash is compared at start.
+const std::vector<ActionEntry>& actionTable();
+std::uint64_t actionTableHash();
+int actionIndex(std::string_view name);  // -1 if unknown
+
+}  // namespace pvr::node

@@ -1,0 +1,155 @@
+// pvr-node: the MPI program. Server mode is the job a pvrd session runs
+// (server_mode.h, docs/runtime.md):
+//
+//   mpirun -np N pvr-node --server --connect HOST:PORT --data-dir DIR
+//
+// Batch mode renders one scene across the ranks and writes the frame:
+//
+//   mpirun -np N pvr-node --batch SCENE.json -o OUT.exr|OUT.png
+//          [--strategy binary-swap|direct-send|tree|radix-k] [--radix K]
+//          [--decomposition kd|balanced] [--early-termination A]
+//          [--threads N] [--codec auto|rle|rle-zlib|raw] [--size WxH]
+//          [--stats FILE.csv]
+//
+// Every rank reads its own brick (or rank 0 scatters when the format cannot
+// read part of a file), renders it, and the ranks composite; rank 0 writes
+// the image and prints the time breakdown. Any rank's failure makes every
+// rank exit 1 with the first failure printed once, by rank 0.
+#include <cstdio>
+#include <string>
+
+#include "frame.h"
+#include "image_io.h"
+#include "mpi_communicator.h"
+#include "report.h"
+#include "server_mode.h"
+
+namespace {
+
+using namespace pvr;
+
+struct Args {
+  std::string scene, output, stats;
+  int width = 0, height = 0;
+  node::FrameOptions frame;
+};
+
+constexpr const char* kUsage =
+    "usage: mpirun -np N pvr-node --server --connect HOST:PORT --data-dir DIR\n"
+    "       mpirun -np N pvr-node --batch SCENE.json -o OUT.exr|OUT.png [--strategy NAME] [--radix K]\n"
+    "       [--decomposition kd|balanced] [--early-termination A] [--threads N]\n"
+    "       [--codec auto|rle|rle-zlib|raw] [--size WxH] [--stats FILE.csv]\n";
+
+[[noreturn]] void bad(const std::string& why) { throw Error(ErrorCode::kInvalidArgument, why); }
+
+int integer(const std::string& option, const std::string& v) {
+  std::size_t used = 0;
+  int value = 0;
+  try {
+    value = std::stoi(v, &used);
+  } catch (const std::logic_error&) {
+    used = 0;
+  }
+  if (used != v.size()) bad(option + " takes an integer, not '" + v + "'");
+  return value;
+}
+
+core::ImageCodec codecNamed(const std::string& v) {
+  if (v == "auto") return core::ImageCodec::kAuto;
+  if (v == "rle") return core::ImageCodec::kRle;
+  if (v == "rle-zlib") return core::ImageCodec::kRleZlib;
+  if (v == "raw") return core::ImageCodec::kRaw;
+  bad("--codec takes auto, rle, rle-zlib or raw, not '" + v + "'");
+}
+
+// The same arguments on every rank give the same result or the same error.
+Args parseArgs(int argc, char** argv) {
+  Args a;
+  bool batch = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) bad(arg + " needs a value");
+      return argv[++i];
+    };
+    if (arg == "--batch") {
+      batch = true;
+      a.scene = value();
+    } else if (arg == "-o") {
+      a.output = value();
+    } else if (arg == "--strategy") {
+      a.frame.strategy = value();
+    } else if (arg == "--radix") {
+      a.frame.strategyParams.radix = integer(arg, value());
+    } else if (arg == "--decomposition") {
+      const std::string v = value();
+      if (v == "kd") a.frame.decomposition = node::Decomposition::kKd;
+      else if (v == "balanced") a.frame.decomposition = node::Decomposition::kBalanced;
+      else bad("--decomposition takes kd or balanced, not '" + v + "'");
+    } else if (arg == "--early-termination") {
+      const std::string v = value();
+      try {
+        a.frame.earlyTermination = std::stod(v);
+      } catch (const std::logic_error&) {
+        bad("--early-termination takes a number in (0, 1], not '" + v + "'");
+      }
+    } else if (arg == "--threads") {
+      a.frame.threads = integer(arg, value());
+    } else if (arg == "--codec") {
+      a.frame.codec = codecNamed(value());
+    } else if (arg == "--size") {
+      const std::string v = value();
+      if (std::sscanf(v.c_str(), "%dx%d", &a.width, &a.height) != 2 || a.width < 1 || a.height < 1)
+        bad("--size takes WxH, not '" + v + "'");
+    } else if (arg == "--stats") {
+      a.stats = value();
+    } else {
+      bad("unknown argument '" + arg + "'");
+    }
+  }
+  if (!batch) bad("--batch SCENE.json is required");
+  if (a.output.empty()) bad("no output file (-o)");
+  return a;
+}
+
+int run(const Args& args, comm::Communicator& comm) {
+  core::Scene scene;
+  comm::runAgreed(comm, [&] {
+    scene = core::loadSceneFile(args.scene);
+    if (args.width > 0) scene.image.width = args.width, scene.image.height = args.height;
+  });
+  const node::FrameResult result = node::renderFrame(scene, args.frame, comm);
+  comm::runAgreed(comm, [&] {
+    if (comm.rank() != 0) return;
+    core::writeImage(result.image, result.scene.image.background, args.output);
+    if (!args.stats.empty()) node::writeStatsCsv(args.stats, result, args.frame);
+    std::printf("%s: %s", args.output.c_str(), node::formatReport(result, args.frame).c_str());
+  });
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) != "--server") continue;
+    node::ServerOptions options;
+    std::string error;
+    if (!node::parseServerOptions(argc, argv, options, error)) {
+      std::fprintf(stderr, "pvr-node: %s\n", error.c_str());
+      return 2;
+    }
+    return node::runServer(options);
+  }
+  comm::MpiEnvironment mpi(&argc, &argv);
+  comm::Communicator& comm = mpi.world();
+  try {
+    return run(parseArgs(argc, argv), comm);
+  } catch (const Error& e) {
+    if (comm.rank() == 0) {
+      std::fprintf(stderr, "pvr-node: %s\n", e.what());
+      if (e.code() == ErrorCode::kInvalidArgument) std::fputs(kUsage, stderr);
+    }
+    return e.code() == ErrorCode::kInvalidArgument ? 2 : 1;
+  }
+}

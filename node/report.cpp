@@ -1,0 +1,107 @@
+#include "report.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+
+#include "error.h"
+
+namespace pvr::node {
+
+namespace {
+
+struct Column {
+  const char* name;
+  std::function<double(const RankReport&)> value;
+};
+
+std::vector<Column> timeColumns() {
+  return {{"dist", [](const RankReport& r) { return r.dist; }},
+          {"rend", [](const RankReport& r) { return r.rend; }},
+          {"comp", [](const RankReport& r) { return r.comp; }},
+          {"comm", [](const RankReport& r) { return r.comm; }},
+          {"send", [](const RankReport& r) { return r.send; }}};
+}
+
+std::string line(const char* format, auto... args) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, format, args...);
+  return buffer;
+}
+
+const char* decompositionName(Decomposition d) { return d == Decomposition::kKd ? "kd" : "balanced"; }
+
+}  // namespace
+
+TrafficTotals sumTraffic(const std::vector<RankReport>& ranks) {
+  TrafficTotals t;
+  for (const RankReport& r : ranks) {
+    t.messages += r.composite.messagesSent;
+    t.maxMessagesPerRank = std::max(t.maxMessagesPerRank, r.composite.messagesSent);
+    t.rawBytes += r.composite.rawBytesSent;
+    t.encodedBytes += r.composite.encodedBytesSent;
+    t.pixels += r.composite.pixelsSent;
+    t.gatherBytes += r.composite.gatherBytesSent;
+  }
+  return t;
+}
+
+std::string formatReport(const FrameResult& result, const FrameOptions& options) {
+  const auto& ranks = result.ranks;
+  const int n = int(ranks.size());
+  std::string out;
+  out += line("%s, %d ranks, %s, %s decomposition, %dx%d\n", result.volume.c_str(), n,
+              options.strategy.c_str(), decompositionName(options.decomposition),
+              result.scene.image.width, result.scene.image.height);
+  out += "time (s)    max       mean      min\n";
+  for (const Column& c : timeColumns()) {
+    double mx = 0, sum = 0, mn = 1e300;
+    for (const RankReport& r : ranks) {
+      mx = std::max(mx, c.value(r));
+      mn = std::min(mn, c.value(r));
+      sum += c.value(r);
+    }
+    out += line("%-8s %9.4f %9.4f %9.4f\n", c.name, mx, sum / n, mn);
+  }
+  const TrafficTotals traffic = sumTraffic(ranks);
+  const std::uint64_t messages = traffic.messages, maxMessages = traffic.maxMessagesPerRank,
+                      raw = traffic.rawBytes, encoded = traffic.encodedBytes, pixels = traffic.pixels,
+                      gatherBytes = traffic.gatherBytes;
+  std::uint64_t maxBrick = 0, sumBrick = 0;
+  for (const RankReport& r : ranks) {
+    maxBrick = std::max(maxBrick, r.brickBytes);
+    sumBrick += r.brickBytes;
+  }
+  out += line("compositing: %llu messages (at most %llu per rank), %llu pixels, %.3f MB as float RGBA, "
+              "%.3f MB sent (%.1fx smaller)\n",
+              (unsigned long long)messages, (unsigned long long)maxMessages, (unsigned long long)pixels,
+              raw * 1e-6, encoded * 1e-6, encoded ? double(raw) / double(encoded) : 1.0);
+  out += line("gather: %.3f MB to rank 0\n", gatherBytes * 1e-6);
+  out += line("voxels per rank: at most %.3f MB, mean %.3f MB; volume / ranks = %.3f MB (%d ghost layers, %s)\n",
+              maxBrick * 1e-6, sumBrick * 1e-6 / n, result.volumeBytes * 1e-6 / n, result.ghostLayers,
+              result.readPartially ? "each rank read its own brick" : "rank 0 read the volume and scattered");
+  if (!result.readPartially)
+    out += line("rank 0 held the whole volume (%.3f MB) while scattering\n", result.rootReadBytes * 1e-6);
+  return out;
+}
+
+void writeStatsCsv(const std::string& path, const FrameResult& result, const FrameOptions& options) {
+  std::ofstream out(path);
+  if (!out) throw Error(ErrorCode::kIo, path + ": cannot open for writing");
+  out << "rank,ranks,strategy,decomposition,width,height,dist,rend,comp,comm,send,messages,"
+         "raw_bytes,encoded_bytes,pixels_sent,gather_messages,gather_bytes,brick_bytes,volume_bytes\n";
+  for (std::size_t i = 0; i < result.ranks.size(); ++i) {
+    const RankReport& r = result.ranks[i];
+    out << i << ',' << result.ranks.size() << ',' << options.strategy << ','
+        << decompositionName(options.decomposition) << ',' << result.scene.image.width << ','
+        << result.scene.image.height << ',' << r.dist << ',' << r.rend << ',' << r.comp << ',' << r.comm
+        << ',' << r.send << ',' << r.composite.messagesSent << ',' << r.composite.rawBytesSent << ','
+        << r.composite.encodedBytesSent << ',' << r.composite.pixelsSent << ','
+        << r.composite.gatherMessagesSent << ',' << r.composite.gatherBytesSent << ',' << r.brickBytes
+        << ',' << result.volumeBytes << '\n';
+  }
+  if (!out) throw Error(ErrorCode::kIo, path + ": write failed");
+}
+
+}  // namespace pvr::node

@@ -1,0 +1,26 @@
+// The time breakdown of a distributed frame, printed like Table 1 of the
+// binary-swap paper (dist, rend, comp, comm, send: max over ranks), with
+// the bytes and messages of compositing and the voxel bytes per rank; and
+// the same per rank as CSV.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "frame.h"
+
+namespace pvr::node {
+
+// Compositing traffic of a frame summed over its ranks.
+struct TrafficTotals {
+  std::uint64_t messages = 0, maxMessagesPerRank = 0;
+  std::uint64_t rawBytes = 0, encodedBytes = 0, pixels = 0, gatherBytes = 0;
+};
+TrafficTotals sumTraffic(const std::vector<RankReport>& ranks);
+
+std::string formatReport(const FrameResult& result, const FrameOptions& options);
+// One row per rank; throws pvr::Error naming the path if it cannot write.
+void writeStatsCsv(const std::string& path, const FrameResult& result, const FrameOptions& options);
+
+}  // namespace pvr::node

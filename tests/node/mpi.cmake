@@ -1,0 +1,41 @@
+# The distributed frame under real mpirun: one driver per rank count that
+# loops over strategies x decompositions x views inside a single job (MPI
+# start-up costs ~0.5 s per job), and pvr-node --batch against pvr-render.
+if(TARGET pvr_comm_mpi AND TARGET pvr-node)
+  add_executable(pvr_node_mpi_driver mpi_driver.cpp)
+  target_link_libraries(pvr_node_mpi_driver PRIVATE pvr_node_frame pvr_comm_mpi ZLIB::ZLIB)
+  set(PVR_MPI_ENV OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1)
+  set(PVR_MPIRUN ${MPIEXEC_EXECUTABLE} --oversubscribe --bind-to none)
+  set(PVR_MPI_SCRATCH ${CMAKE_CURRENT_BINARY_DIR}/scratch)
+
+  # Every strategy x decomposition x view, one job per rank count.
+  foreach(ranks RANGE 1 8)
+    add_test(NAME "node mpi: ${ranks} ranks equal the single-process render"
+             COMMAND ${PVR_MPIRUN} -np ${ranks} $<TARGET_FILE:pvr_node_mpi_driver>
+                     matrix ${PVR_MPI_SCRATCH}/matrix-${ranks})
+    set_tests_properties("node mpi: ${ranks} ranks equal the single-process render"
+                         PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 240 PROCESSORS 2)
+  endforeach()
+
+  # One rank's brick read throws: all fail alike, nothing deadlocks.
+  foreach(ranks 3 4)
+    add_test(NAME "node mpi: ${ranks} ranks fail together when one rank's brick is bad"
+             COMMAND ${PVR_MPIRUN} -np ${ranks} $<TARGET_FILE:pvr_node_mpi_driver>
+                     failure ${PVR_MPI_SCRATCH}/failure-${ranks})
+    set_tests_properties("node mpi: ${ranks} ranks fail together when one rank's brick is bad"
+                         PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 60 PROCESSORS 2)
+  endforeach()
+
+  # The programs themselves: pvr-node under mpirun against pvr-render, and a
+  # bad scene failing on every rank with one message.
+  if(TARGET pvr-render)
+    add_test(NAME "node mpi: pvr-node --batch equals pvr-render"
+             COMMAND ${CMAKE_COMMAND}
+                     -DMPIRUN=${MPIEXEC_EXECUTABLE} -DPVR_NODE=$<TARGET_FILE:pvr-node>
+                     -DPVR_RENDER=$<TARGET_FILE:pvr-render> -DDRIVER=$<TARGET_FILE:pvr_node_mpi_driver>
+                     -DWORK=${PVR_MPI_SCRATCH}/programs
+                     -P ${CMAKE_CURRENT_SOURCE_DIR}/pvr_node_test.cmake)
+    set_tests_properties("node mpi: pvr-node --batch equals pvr-render"
+                         PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 120 PROCESSORS 2)
+  endif()
+endif()

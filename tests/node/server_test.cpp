@@ -1,0 +1,381 @@
+// pvr-node --server under real mpirun, driven by this test as the session
+// handler would: listen on loopback, start the job, speak the protocol.
+// Every frame must equal an in-process BrickRenderer rendering of the same
+// view within 1e-5 (the job writes its float frames with --dump-frames),
+// in order, for each layout of the session.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "camera.h"
+#include "frame_pixels.h"
+#include "io/volume_io.h"
+#include "pvr_protocol.h"
+#include "raycast/raycaster.h"
+#include "scene.h"
+#include "thread_pool.h"
+
+namespace {
+
+using namespace pvr;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using proto::ClusterRole;
+
+const fs::path kTmp = PVR_TEST_TMP;
+constexpr int kDims[3] = {40, 36, 33};
+
+// A float32 raw volume with its JSON sidecar in `dir`.
+void writeVolume(const fs::path& dir) {
+  fs::create_directories(dir);
+  const core::Brick whole = core::openProcedural("shepp-logan", {kDims[0], kDims[1], kDims[2]})->readAll();
+  std::ofstream raw(dir / "phantom.raw", std::ios::binary);
+  const auto nodes = whole.stored().nodeCount();
+  REQUIRE(whole.byteSize() == std::size_t(nodes) * 4);
+  raw.write(reinterpret_cast<const char*>(whole.bytes()), std::streamsize(whole.byteSize()));
+  std::ofstream(dir / "phantom.json") << nlohmann::json{{"dims", {kDims[0], kDims[1], kDims[2]}},
+                                                        {"dtype", "float32"},
+                                                        {"spacing", {1.0, 1.0, 1.25}},
+                                                        {"raw_file", "phantom.raw"}}
+                                             .dump();
+}
+
+const char* kScene = R"({
+  "transfer_function": {"points": [[0, 0, 0, 0, 0], [0.15, 0.3, 0.5, 1, 0.05], [0.3, 1, 0.8, 0.3, 0.3], [1, 1, 1, 1, 0.6]]},
+  "image": {"width": 64, "height": 64, "background": [0, 0, 0, 1]},
+  "shading": {"enabled": true}})";
+
+// The handler's side of one job.
+class Job {
+ public:
+  Job(int ranks, const std::vector<std::string>& extra) {
+    dumpDir_ = kTmp / ("frames-" + std::to_string(ranks) + "-" + std::to_string(::getpid()));
+    fs::remove_all(dumpDir_);
+    fs::create_directories(dumpDir_);
+    listen_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    REQUIRE(::bind(listen_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0);
+    REQUIRE(::listen(listen_, 1) == 0);
+    socklen_t len = sizeof addr;
+    ::getsockname(listen_, reinterpret_cast<sockaddr*>(&addr), &len);
+    std::vector<std::string> args{PVR_MPIRUN, "--oversubscribe", "--bind-to", "none", "-np", std::to_string(ranks),
+                                  PVR_NODE_PATH, "--server", "--connect",
+                                  "127.0.0.1:" + std::to_string(ntohs(addr.sin_port)), "--data-dir",
+                                  (kTmp / "data").string(), "--dump-frames", dumpDir_.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::setpgid(0, 0);
+      ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+      ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      ::execvp(argv[0], argv.data());
+      ::_exit(127);
+    }
+    ::setpgid(pid_, pid_);
+    pollfd p{listen_, POLLIN, 0};
+    REQUIRE(::poll(&p, 1, 60000) == 1);
+    fd_ = ::accept4(listen_, nullptr, nullptr, SOCK_CLOEXEC);
+    REQUIRE(fd_ >= 0);
+  }
+  ~Job() {
+    if (fd_ >= 0) ::close(fd_);
+    ::close(listen_);
+    if (pid_ > 0 && !reaped_) {
+      // Close makes the job end by itself; kill what is left after 20 s.
+      const auto until = Clock::now() + std::chrono::seconds(20);
+      int status = 0;
+      while (::waitpid(pid_, &status, WNOHANG) == 0) {
+        if (Clock::now() > until) {
+          ::kill(-pid_, SIGKILL);
+          ::waitpid(pid_, &status, 0);
+          break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    }
+  }
+  pid_t pid() const { return pid_; }
+  const fs::path& dumpDir() const { return dumpDir_; }
+
+  std::uint32_t send(const proto::Message& m) {
+    const auto bytes = proto::encode(m, ++id_, proto::kFlagFinal);
+    REQUIRE(::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL) == ssize_t(bytes.size()));
+    return id_;
+  }
+  // The next message from the master; nullopt when the connection ended.
+  std::optional<proto::Decoded> receive(int timeoutSeconds = 60) {
+    const auto until = Clock::now() + std::chrono::seconds(timeoutSeconds);
+    for (;;) {
+      if (auto d = decoder_.pop()) return d;
+      REQUIRE_FALSE(decoder_.error());
+      const int left = int(std::chrono::duration_cast<std::chrono::milliseconds>(until - Clock::now()).count());
+      REQUIRE(left > 0);
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, left) <= 0) continue;
+      std::uint8_t buf[1 << 16];
+      const ssize_t n = ::read(fd_, buf, sizeof buf);
+      if (n <= 0) return std::nullopt;
+      decoder_.feed(std::span(buf, std::size_t(n)));
+    }
+  }
+  template <typename T>
+  T expect() {
+    auto d = receive();
+    REQUIRE(d);
+    if (const auto* e = std::get_if<proto::ErrorMessage>(&d->message)) FAIL("Error from the master: " << e->text);
+    REQUIRE(std::holds_alternative<T>(d->message));
+    return std::get<T>(d->message);
+  }
+  proto::ErrorMessage expectError() {
+    auto d = receive();
+    REQUIRE(d);
+    REQUIRE(std::holds_alternative<proto::ErrorMessage>(d->message));
+    return std::get<proto::ErrorMessage>(d->message);
+  }
+  // Waits for mpirun to exit; true if it did within `seconds`.
+  bool reap(int seconds) {
+    const auto until = Clock::now() + std::chrono::seconds(seconds);
+    int status = 0;
+    while (Clock::now() < until) {
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) return reaped_ = true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+
+ private:
+  int listen_ = -1, fd_ = -1;
+  pid_t pid_ = -1;
+  bool reaped_ = false;
+  std::uint32_t id_ = 0;
+  proto::FrameDecoder decoder_;
+  fs::path dumpDir_;
+};
+
+// The reference: the whole volume rendered in this process.
+class Reference {
+ public:
+  explicit Reference(const nlohmann::json& patch) {
+    nlohmann::json doc = nlohmann::json::parse(kScene);
+    doc.merge_patch(patch);
+    doc["volume"] = {{"file", (kTmp / "data" / "phantom.json").string()}};
+    scene_ = core::parseScene(doc, "");
+    source_ = core::openVolumeFile((kTmp / "data" / "phantom.json").string());
+    core::resolveDefaults(scene_, source_->grid());
+    brick_ = source_->readAll();
+    renderer_ = std::make_unique<core::BrickRenderer>(brick_);
+    options_ = core::renderOptionsFor(scene_);
+    renderer_->classify(scene_.transfer, options_);
+  }
+  // Frame k of RenderRotation{axis (0,1,0) or given, 0.., steps}: the
+  // master's formula (server_mode.cpp).
+  core::Image frame(int k, int steps, core::Vec3 axis = {0, 1, 0}) const {
+    core::CameraSpec c = scene_.camera;
+    const double angle = 2 * M_PI * double(k) / double(steps);
+    const auto rotate = [&](const core::Vec3& v) {
+      const double co = std::cos(angle), s = std::sin(angle);
+      const core::Vec3 cross{axis.y * v.z - axis.z * v.y, axis.z * v.x - axis.x * v.z, axis.x * v.y - axis.y * v.x};
+      const double dot = axis.x * v.x + axis.y * v.y + axis.z * v.z;
+      return core::Vec3{v.x * co + cross.x * s + axis.x * dot * (1 - co), v.y * co + cross.y * s + axis.y * dot * (1 - co),
+                        v.z * co + cross.z * s + axis.z * dot * (1 - co)};
+    };
+    if (k != 0) {
+      c.eye = scene_.camera.lookAt + rotate(scene_.camera.eye - scene_.camera.lookAt);
+      c.up = rotate(scene_.camera.up);
+    }
+    const core::Camera camera(c, scene_.image.width, scene_.image.height);
+    return renderer_->render(camera, options_, pool_).toFullFrame();
+  }
+
+ private:
+  core::Scene scene_;
+  std::unique_ptr<core::VolumeSource> source_;
+  core::Brick brick_;
+  std::unique_ptr<core::BrickRenderer> renderer_;
+  core::RenderOptions options_;
+  mutable core::ThreadPool pool_{1};
+};
+
+core::Image dumped(const Job& job, std::uint32_t request, int frame) {
+  const fs::path path = job.dumpDir() / ("frame-" + std::to_string(request) + "-" + std::to_string(frame) + ".f32");
+  std::ifstream in(path, std::ios::binary);
+  REQUIRE(in);
+  std::int32_t size[2];
+  in.read(reinterpret_cast<char*>(size), sizeof size);
+  core::Image image = core::Image::fullFrame(size[0], size[1]);
+  in.read(reinterpret_cast<char*>(image.pixels().data()), std::streamsize(image.pixels().size() * sizeof(core::Rgba)));
+  REQUIRE(in);
+  return image;
+}
+
+// A sequence's frames: in order, the last FINAL, each equal to the reference.
+void checkSequence(Job& job, std::uint32_t request, int frames, int steps, const Reference& ref) {
+  for (int k = 0; k < frames; ++k) {
+    auto d = job.receive();
+    REQUIRE(d);
+    if (const auto* e = std::get_if<proto::ErrorMessage>(&d->message)) FAIL("frame " << k << ": " << e->text);
+    const auto& f = std::get<proto::ImageFrame>(d->message);
+    CHECK(d->info.requestId == request);
+    CHECK(f.frameNumber == std::uint32_t(k));
+    CHECK(d->info.final() == (k == frames - 1));
+    CHECK(f.timing.render > 0);
+    const double diff = core::maxAbsDifference(dumped(job, request, k), ref.frame(k, steps));
+    INFO("frame " << k);
+    CHECK(diff <= 1e-5);
+  }
+}
+
+struct Fixture {
+  Fixture() {
+    static bool written = false;
+    if (!written) writeVolume(kTmp / "data");
+    written = true;
+  }
+};
+
+}  // namespace
+
+TEST_CASE_METHOD(Fixture, "clusters, groups and a compositing cluster all render what pvr-render renders") {
+  Job job(4, {"--fail-once", "render@2"});
+  job.send(proto::Hello{"runtime test"});
+  job.expect<proto::Welcome>();
+  job.send(proto::SessionOpen{4, {}});
+  const auto ready = job.expect<proto::SessionReady>();
+  REQUIRE(ready.clusters.size() == 1);
+  CHECK(ready.clusters[0].ranks == 4);
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  const Reference ref(nlohmann::json::object());
+  // An action failing on one rank: the client reads that rank's error and
+  // the next render works.
+  job.send(proto::RenderFrame{});
+  const auto e = job.expectError();
+  CHECK(e.text.find("rank 2: injected failure in action render") != std::string::npos);
+
+  SECTION("one cluster compositing itself; memory and latency reports") {
+    const auto id = job.send(proto::RenderFrame{});
+    checkSequence(job, id, 1, 1, ref);
+
+    // Memory: each of the 4 ranks at most 1/4 of the volume plus ghosts plus 10 %.
+    job.send(proto::PerformanceRequest{proto::PerformanceQuery::kMemory, proto::kAllClusters});
+    const auto memory = nlohmann::json::parse(job.expect<proto::PerformanceReply>().json);
+    const double volume = memory["volume_bytes"].get<double>();
+    const int ghost = memory["ghost_layers"].get<int>();
+    const double faces = 2.0 * ghost * (kDims[0] * kDims[1] + kDims[1] * kDims[2] + kDims[0] * kDims[2]) * 4;
+    REQUIRE(memory["clusters"].size() == 1);
+    for (const auto& b : memory["clusters"][0]["bytes_per_rank"]) {
+      CHECK(b.get<double>() > 0);
+      CHECK(b.get<double>() <= volume / 4 * 1.1 + faces);
+    }
+    // The latency model beside the measured value.
+    job.send(proto::PerformanceRequest{proto::PerformanceQuery::kCompositing, proto::kAllClusters});
+    const auto latency = nlohmann::json::parse(job.expect<proto::PerformanceReply>().json);
+    REQUIRE(latency["clusters"].size() == 1);
+    CHECK(latency["clusters"][0]["model_seconds"].get<double>() > 0);
+    CHECK(latency["clusters"][0]["measured_seconds"].get<double>() > 0);
+    CHECK(latency["calibration"]["latency_seconds"].get<double>() > 0);
+  }
+  SECTION("two clusters in one group split the scanlines") {
+    job.send(proto::SetLayout{{{ClusterRole::kRender, 2, 0}, {ClusterRole::kRender, 2, 0}}});
+    CHECK(job.expect<proto::SessionReady>().clusters.size() == 2);
+    const auto id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 2, 12});
+    checkSequence(job, id, 3, 12, ref);
+  }
+  SECTION("two groups pipeline a 12-frame rotation, frames in order") {
+    job.send(proto::SetLayout{{{ClusterRole::kRender, 2, 0}, {ClusterRole::kRender, 2, 1}}});
+    job.expect<proto::SessionReady>();
+    const auto id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 11, 12});
+    checkSequence(job, id, 12, 12, ref);
+  }
+  SECTION("a separate compositing cluster; then rank 0 as a dedicated collector") {
+    job.send(proto::SetLayout{{{ClusterRole::kRender, 2, 0}, {ClusterRole::kComposite, 2, 0}}});
+    job.expect<proto::SessionReady>();
+    auto id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 2, 12});
+    checkSequence(job, id, 3, 12, ref);
+    job.send(proto::SetLayout{{{ClusterRole::kRender, 2, 0}, {ClusterRole::kComposite, 1, 0}}});
+    const auto ready3 = job.expect<proto::SessionReady>();
+    CHECK(ready3.clusters[0].role == ClusterRole::kCollector);
+    id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 2, 12});
+    checkSequence(job, id, 3, 12, ref);
+  }
+  SECTION("content balance: a new transfer function rebalances; RGB8 with RLE decodes") {
+    job.send(proto::SetScene{"", R"({"runtime": {"decomposition": "balanced", "rebalance_threshold": 1.0001, "pixels": "rgb8", "compression": "rle"}})"});
+    job.expect<proto::Ok>();
+    // Only the inner structures, which the phantom places off-centre.
+    const char* narrow =
+        R"({"transfer_function": {"points": [[0, 0, 0, 0, 0], [0.22, 0, 0, 0, 0], [0.3, 1, 0.9, 0.8, 0.8], [0.38, 0, 0, 0, 0], [1, 0, 0, 0, 0]]}})";
+    job.send(proto::SetScene{"", narrow});
+    job.expect<proto::Ok>();
+    job.send(proto::StatusRequest{});
+    for (const auto& kv : job.expect<proto::StatusReply>().entries)
+      if (kv.key == "rebalances") CHECK(std::stoi(kv.value) >= 1);
+    const auto id = job.send(proto::RenderFrame{});
+    auto d = job.receive();
+    REQUIRE(d);
+    REQUIRE(std::holds_alternative<proto::ImageFrame>(d->message));
+    const auto& f = std::get<proto::ImageFrame>(d->message);
+    CHECK(f.format == proto::PixelFormat::kRgb8);
+    CHECK(node::decompressPixels(f.pixels, 64 * 64 * 3, f.format, f.compression).size() == 64 * 64 * 3);
+    const Reference narrowRef(nlohmann::json::parse(narrow));
+    CHECK(core::maxAbsDifference(dumped(job, id, 0), narrowRef.frame(0, 1)) <= 1e-5);
+  }
+  job.send(proto::Close{"done"});
+  CHECK(job.reap(30));
+}
+
+TEST_CASE_METHOD(Fixture, "a rank killed mid-sequence: the handler side sees the end and nothing is left running") {
+  Job job(3, {});
+  job.send(proto::SessionOpen{3, {}});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  job.send(proto::RenderRotation{{0, 1, 0}, 0, 5000, 5000});
+  job.expect<proto::ImageFrame>();
+  // The ranks are mpirun's children; kill one that is not the master.
+  std::vector<pid_t> ranks;
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    std::ifstream stat(entry.path() / "stat");
+    std::string pid, comm, state;
+    pid_t ppid = 0;
+    if (stat >> pid >> comm >> state >> ppid && ppid == job.pid()) ranks.push_back(std::stoi(pid));
+  }
+  REQUIRE(ranks.size() == 3);
+  std::sort(ranks.begin(), ranks.end());
+  REQUIRE(::kill(ranks.back(), SIGKILL) == 0);
+  // Frames stop: the connection ends (or an Error arrives) within 30 s.
+  bool ended = false;
+  for (int i = 0; i < 6000 && !ended; ++i) {
+    auto d = job.receive(30);
+    ended = !d || std::holds_alternative<proto::ErrorMessage>(d->message);
+  }
+  CHECK(ended);
+  CHECK(job.reap(30));
+  // Gone, or a zombie waiting for init: nothing runs (mpirun reaps the
+  // ranks it killed; their process groups are their own).
+  const auto running = [](pid_t pid) {
+    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+    std::string p, comm, state;
+    return bool(stat >> p >> comm >> state) && state != "Z";
+  };
+  for (int i = 0; i < 100 && std::any_of(ranks.begin(), ranks.end(), running); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  for (pid_t r : ranks) CHECK_FALSE(running(r));
+}

@@ -1,0 +1,89 @@
+# Helpers shared by the pvr tcltest files: a small raw+JSON volume in a
+# temporary data directory, and pvrd started on an ephemeral loopback port.
+#
+# The environment (set by tests/pvrsh/CMakeLists.txt) names the programs:
+# PVRD, PVR_NODE (pvr-node), PVR_RENDER, PVR_TEST_TMP.
+
+package require tcltest 2
+namespace import ::tcltest::*
+package require pvr
+
+namespace eval ::pvrtest {
+    variable tmp [file join $::env(PVR_TEST_TMP) [pid]]
+    variable pvrd ""        ;# channel of the running pvrd
+    variable pvrdPid 0
+    variable port 0
+}
+
+# ::pvrtest::makeData DIR: writes ball/ball.raw + ball.json, a 32^3 uint8
+# sphere whose value falls off from the centre, and a second copy "cube".
+proc ::pvrtest::makeData {dir} {
+    file mkdir [file join $dir ball]
+    set n 32
+    set bytes {}
+    for {set z 0} {$z < $n} {incr z} {
+        for {set y 0} {$y < $n} {incr y} {
+            set row {}
+            for {set x 0} {$x < $n} {incr x} {
+                set r [expr {sqrt(($x-15.5)**2 + ($y-15.5)**2 + ($z-15.5)**2)}]
+                lappend row [expr {$r < 12 ? int(255 - $r * 10) : 0}]
+            }
+            append bytes [binary format c* $row]
+        }
+    }
+    set f [open [file join $dir ball ball.raw] wb]
+    puts -nonewline $f $bytes
+    close $f
+    set f [open [file join $dir ball ball.json] w]
+    puts $f {{"dims": [32, 32, 32], "dtype": "uint8", "spacing": [1, 1, 1], "origin": [0, 0, 0], "raw_file": "ball.raw", "endian": "little"}}
+    close $f
+    return $dir
+}
+
+# ::pvrtest::startPvrd ?ARGS?: starts pvrd on 127.0.0.1:0 over a fresh data
+# directory; returns the port. Stopped by stopPvrd (or at exit).
+proc ::pvrtest::startPvrd {args} {
+    variable tmp
+    variable pvrd
+    variable pvrdPid
+    variable port
+    set data [makeData [file join $tmp data]]
+    set cmd [list $::env(PVRD) --listen 127.0.0.1:0 --data-dir $data --node $::env(PVR_NODE) {*}$args]
+    set pvrd [open |[concat $cmd [list 2>> [file join $tmp pvrd.log]]] r]
+    set pvrdPid [pid $pvrd]
+    gets $pvrd line
+    if {![regexp {pvrd listening on 127.0.0.1:(\d+)} $line -> port]} {
+        error "pvrd did not start: $line"
+    }
+    return $port
+}
+
+proc ::pvrtest::stopPvrd {} {
+    variable pvrd
+    variable pvrdPid
+    if {$pvrd eq ""} return
+    catch {exec kill -TERM $pvrdPid}
+    catch {close $pvrd}
+    set pvrd ""
+    set pvrdPid 0
+}
+
+# ::pvrtest::killPvrd: SIGKILL, as a crash would.
+proc ::pvrtest::killPvrd {} {
+    variable pvrd
+    variable pvrdPid
+    catch {exec kill -KILL $pvrdPid}
+    catch {close $pvrd}
+    set pvrd ""
+    set pvrdPid 0
+}
+
+# ::pvrtest::errorcode SCRIPT: the -errorcode of SCRIPT's error, or "ok".
+proc ::pvrtest::errorcode {script} {
+    if {[catch {uplevel 1 $script} msg opts]} {
+        return [dict get $opts -errorcode]
+    }
+    return ok
+}
+
+file mkdir $::pvrtest::tmp
