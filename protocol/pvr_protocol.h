@@ -6,6 +6,7 @@
 #include "frame_codec.h"
 #include "frame_decoder.h"
 #include "frame_header.h"
+#include "image_limits.h"
 #include "message_dispatcher.h"
 #include "message_table.h"
 #include "protocol_error.h"
