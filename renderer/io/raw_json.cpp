@@ -6,12 +6,9 @@
 // Other keys (provenance, licence, statistics) are ignored. Either file may
 // be given: a .raw finds its sidecar beside it, <stem>.json.
 #include <filesystem>
-#include <fstream>
-#include <sstream>
-
-#include <nlohmann/json.hpp>
 
 #include "formats.h"
+#include "json_file.h"
 #include "raw_reader.h"
 #include "source_util.h"
 
@@ -22,25 +19,10 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// A sidecar is a few kilobytes; refuse to slurp a multi-megabyte file named .json.
-constexpr std::uint64_t kMaxSidecarBytes = std::uint64_t(1) << 24;
-
 json readSidecar(const std::string& path) {
-  const std::uint64_t size = fileSizeOf(path);
-  if (size > kMaxSidecarBytes)
-    failAt(ErrorCode::kBadFile, path,
-           "sidecar has " + std::to_string(size) + " bytes, more than a volume description needs");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) failAt(ErrorCode::kIo, path, "cannot read the sidecar");
-  try {
-    json doc = json::parse(text.str());
-    if (!doc.is_object()) failAt(ErrorCode::kBadFile, path, "sidecar is not a JSON object");
-    return doc;
-  } catch (const json::parse_error& e) {
-    failAt(ErrorCode::kBadFile, path, std::string("sidecar is not valid JSON: ") + e.what());
-  }
+  json doc = readJsonFile(path);
+  if (!doc.is_object()) failAt(ErrorCode::kBadFile, path, "sidecar is not a JSON object");
+  return doc;
 }
 
 const json& member(const json& doc, const char* key, const std::string& path) {
