@@ -54,8 +54,8 @@ TransferTable::TransferTable(const TransferFunctionSpec& tf, double step) {
   smin_ = tf.points.front().scalar;
   smax_ = tf.points.back().scalar;
   tableMapping(smin_, smax_, kEntries, scale_, offset_);
-  entries_.resize(kEntries + 1);
-  visiblePrefix_.assign(kEntries + 2, 0);
+  entries_.resize(kEntries);
+  visiblePrefix_.assign(kEntries + 1, 0);
   for (int i = 0; i < kEntries; ++i) {
     const double s = smax_ > smin_ ? smin_ + (smax_ - smin_) * i / (kEntries - 1) : smin_;
     const Medium m = evaluateMedium(tf, s);
@@ -64,8 +64,6 @@ TransferTable::TransferTable(const TransferFunctionSpec& tf, double step) {
     entries_[i] = {float(m.r * alpha), float(m.g * alpha), float(m.b * alpha), float(alpha)};
     visiblePrefix_[i + 1] = visiblePrefix_[i] + (alpha > 0 ? 1 : 0);
   }
-  entries_[kTransparentIndex] = {};
-  visiblePrefix_[kEntries + 1] = visiblePrefix_[kEntries];
 }
 
 bool TransferTable::anyVisible(double lo, double hi) const {

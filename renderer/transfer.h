@@ -5,8 +5,8 @@
 // colour and the opacity of ONE ray step h: alpha = 1 - (1 - a)^(h / unit).
 // Outside the control points the function is clamped, so the table domain is
 // the control-point range and never depends on the data: every brick of a
-// split classifies a scalar identically. A last extra entry is transparent;
-// non-finite scalars index it.
+// split classifies a scalar identically. Non-finite scalars never reach a
+// table: the kernels classify them as empty before the look-up.
 //
 // A PreintegratedTable holds, for pairs (s_front, s_back) of the scalars at
 // the ends of a ray segment of length h, the colour and opacity of that
@@ -41,8 +41,7 @@ class TransferTable {
   // Table coordinate of a scalar: scalar * scale + offset, in [0, kEntries-1].
   float scale() const { return scale_; }
   float offset() const { return offset_; }
-  const Rgba* entries() const { return entries_.data(); }  // kEntries + 1 entries
-  static constexpr int kTransparentIndex = kEntries;
+  const Rgba* entries() const { return entries_.data(); }  // kEntries entries
 
   // True if some scalar in [lo, hi] has non-zero opacity. O(1) (prefix sums).
   bool anyVisible(double lo, double hi) const;

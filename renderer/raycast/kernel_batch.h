@@ -107,7 +107,7 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
     loadPairs8(v, index, sy + sz, e0, e1);
     const __m256 value = lerp8(lerp8(lerp8(a0, a1, fx), lerp8(b0, b1, fx), fy),
                                lerp8(lerp8(c0, c1, fx), lerp8(e0, e1, fx), fy), fz);
-    // Table coordinates; a non-finite value takes the transparent entry.
+    // Table coordinates; a non-finite value is made transparent below.
     __m256 x = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(value, scale, offset), _mm256_setzero_ps()),
                              tableLast);
     const __m256i entry = _mm256_min_epi32(_mm256_cvttps_epi32(x), entryLast);

@@ -24,8 +24,8 @@ MacrocellGrid::MacrocellGrid(const Brick& brick) {
   dispatchScalar(brick.type(), [&](auto tag) {
     using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
     const T* v = brick.as<T>();
-    // Each stored node widens every macrocell whose dilated node range
-    // [kSize*m - 1, kSize*m + kSize + 1] holds it: at most two per axis.
+    // Each stored node widens every macrocell whose node range
+    // [kSize*m, kSize*m + kSize] holds it: at most two per axis.
     auto cellsOf = [&](int a, std::int64_t node, std::int64_t& m0, std::int64_t& m1) {
       // m0 = ceil((node - kSize) / kSize), m1 = floor(node / kSize);
       // >> floors negative numbers too.
@@ -94,10 +94,6 @@ void MacrocellGrid::updateDistances() {
   for (int z = nz - 1; z >= 0; --z)
     for (int y = ny - 1; y >= 0; --y)
       for (int x = nx - 1; x >= 0; --x) relax(x, y, z, -1);
-}
-
-std::size_t MacrocellGrid::visibleCount() const {
-  return std::size_t(std::count(visible_.begin(), visible_.end(), std::uint8_t(1)));
 }
 
 }  // namespace pvr::core

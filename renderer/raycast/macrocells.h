@@ -41,7 +41,6 @@ class MacrocellGrid {
   // macrocell at distance d may leap d - 1 macrocells along its major axis
   // without meeting anything visible (space leaping with a distance field).
   const std::uint8_t* distance() const { return distance_.data(); }
-  std::size_t visibleCount() const;
 
  private:
   IVec3 first_, count_;
