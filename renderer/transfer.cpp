@@ -30,12 +30,22 @@ void requireUsable(const TransferFunctionSpec& tf, double step) {
   if (!(step > 0)) throw Error(ErrorCode::kInternal, "transfer function: step must be > 0");
 }
 
-// Maps [smin, smax] onto table coordinates [0, n-1]; a single point maps to 0.
-void tableMapping(double smin, double smax, int n, float& scale, float& offset) {
-  const double s = smax > smin ? double(n - 1) / (smax - smin) : 0.0;
-  scale = float(s);
-  offset = float(-smin * s);
-}
+// A table of n entries over the control points' scalar range [smin, smax]:
+// entry i (fractional for sub-entries) holds scalar(i), and a scalar s is
+// looked up at s * scale + offset. A single point maps everything to entry 0.
+struct TableDomain {
+  double smin, smax;
+  int n;
+
+  TableDomain(const TransferFunctionSpec& tf, int entries)
+      : smin(tf.points.front().scalar), smax(tf.points.back().scalar), n(entries) {}
+  double scalar(double i) const { return smax > smin ? smin + (smax - smin) * i / (n - 1) : smin; }
+  void mapping(float& scale, float& offset) const {
+    const double s = smax > smin ? double(n - 1) / (smax - smin) : 0.0;
+    scale = float(s);
+    offset = float(-smin * s);
+  }
+};
 
 }  // namespace
 
@@ -51,14 +61,12 @@ Medium evaluateMedium(const TransferFunctionSpec& tf, double scalar) {
 
 TransferTable::TransferTable(const TransferFunctionSpec& tf, double step) {
   requireUsable(tf, step);
-  smin_ = tf.points.front().scalar;
-  smax_ = tf.points.back().scalar;
-  tableMapping(smin_, smax_, kEntries, scale_, offset_);
+  const TableDomain domain(tf, kEntries);
+  domain.mapping(scale_, offset_);
   entries_.resize(kEntries);
   visiblePrefix_.assign(kEntries + 1, 0);
   for (int i = 0; i < kEntries; ++i) {
-    const double s = smax_ > smin_ ? smin_ + (smax_ - smin_) * i / (kEntries - 1) : smin_;
-    const Medium m = evaluateMedium(tf, s);
+    const Medium m = evaluateMedium(tf, domain.scalar(i));
     // Opacity of one step: 1 - (1 - a)^(h / unit) = 1 - exp(-tau h).
     const double alpha = -std::expm1(-m.tau * step);
     entries_[i] = {float(m.r * alpha), float(m.g * alpha), float(m.b * alpha), float(alpha)};
@@ -79,16 +87,15 @@ bool TransferTable::anyVisible(double lo, double hi) const {
 
 PreintegratedTable::PreintegratedTable(const TransferFunctionSpec& tf, double step) {
   requireUsable(tf, step);
-  const double smin = tf.points.front().scalar, smax = tf.points.back().scalar;
-  tableMapping(smin, smax, kEntries, scale_, offset_);
+  const TableDomain domain(tf, kEntries);
+  domain.mapping(scale_, offset_);
   const int n = kEntries;
-  auto scalarOf = [&](double i) { return smax > smin ? smin + (smax - smin) * i / (n - 1) : smin; };
 
   // The medium on a fine scalar grid (8 sub-entries per entry), so a
   // segment's integral resolves the transfer function between entries.
   const int fine = 8 * (n - 1) + 1;
   std::vector<Medium> media(fine);
-  for (int i = 0; i < fine; ++i) media[i] = evaluateMedium(tf, scalarOf(double(i) / 8.0));
+  for (int i = 0; i < fine; ++i) media[i] = evaluateMedium(tf, domain.scalar(double(i) / 8.0));
 
   entries_.resize(std::size_t(n) * n);
   for (int f = 0; f < n; ++f) {

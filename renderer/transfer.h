@@ -45,11 +45,8 @@ class TransferTable {
 
   // True if some scalar in [lo, hi] has non-zero opacity. O(1) (prefix sums).
   bool anyVisible(double lo, double hi) const;
-  double scalarMin() const { return smin_; }
-  double scalarMax() const { return smax_; }
 
  private:
-  double smin_ = 0, smax_ = 0;
   float scale_ = 0, offset_ = 0;
   std::vector<Rgba> entries_;
   std::vector<std::uint32_t> visiblePrefix_;  // visiblePrefix_[i] = visible entries below i

@@ -1,4 +1,5 @@
-// Small fixed-size vectors for geometry set-up (double) and the hot loops (float).
+// Small fixed-size vectors for geometry set-up (the hot loops in raycast/
+// work on plain float arrays).
 #pragma once
 
 #include <array>
@@ -24,7 +25,6 @@ struct Vec3T {
 };
 
 using Vec3 = Vec3T<double>;
-using Vec3f = Vec3T<float>;
 
 template <typename T>
 constexpr T dot(Vec3T<T> a, Vec3T<T> b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
@@ -36,10 +36,6 @@ template <typename T>
 T length(Vec3T<T> a) { return std::sqrt(dot(a, a)); }
 template <typename T>
 Vec3T<T> normalize(Vec3T<T> a) { return a / length(a); }
-template <typename T>
-constexpr Vec3T<T> mul(Vec3T<T> a, Vec3T<T> b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
-
-inline Vec3f toFloat(Vec3 v) { return {float(v.x), float(v.y), float(v.z)}; }
 
 // Integer node coordinates (voxel indices).
 struct IVec3 {
