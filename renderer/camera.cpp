@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "error.h"
 
@@ -10,8 +11,10 @@ namespace pvr::core {
 
 Camera::Camera(const CameraSpec& spec, int width, int height)
     : spec_(spec), width_(width), height_(height) {
-  if (width < 1 || height < 1)
-    throw Error(ErrorCode::kInvalidArgument, "camera: image size must be at least 1x1");
+  if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide)
+    throw Error(ErrorCode::kInvalidArgument, "camera: image of " + std::to_string(width) + " x " +
+                                                 std::to_string(height) + " pixels: each side must be in 1.." +
+                                                 std::to_string(kMaxImageSide));
   const Vec3 view = spec.lookAt - spec.eye;
   if (!(length(view) > 0))
     throw Error(ErrorCode::kInvalidArgument, "camera: eye and look_at coincide");

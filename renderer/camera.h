@@ -16,7 +16,8 @@ struct Ray {
 
 class Camera {
  public:
-  // Throws pvr::Error for a degenerate view (eye == look_at, up parallel to it).
+  // Throws pvr::Error for a degenerate view (eye == look_at, up parallel to
+  // it) and for an image side outside 1..kMaxImageSide (scene.h).
   Camera(const CameraSpec& spec, int width, int height);
 
   int width() const { return width_; }

@@ -1,7 +1,11 @@
 // Scene: the one JSON document the CLI, the benches and the protocol share.
 //
-// Plain data; parsing and printing live in scene.cpp, the meaning of every
-// key in docs/scene.md. Positions, step and unit_distance are world lengths.
+// Plain data and the functions that read, print and complete it; the
+// meaning of every key is in docs/scene.md. Positions, step and
+// unit_distance are world lengths. One file per job: scene.cpp (the
+// document), scene_*_section.cpp (one section each, read and written),
+// paraview_preset.cpp (ParaView presets), scene_defaults.cpp (what needs
+// the volume: unit distance, step, the automatic camera).
 #pragma once
 
 #include <array>
@@ -47,8 +51,18 @@ struct CameraSpec {
   Vec3 up{0, 0, 1};
   double height = 0;      // orthographic: view height in world units
   double fovYDeg = 30;    // perspective: vertical field of view
-  bool automatic = true;  // no "camera" key: fit the volume (resolveDefaults)
+  bool automatic = true;  // no "camera" key: automaticCamera, set by resolveDefaults
 };
+
+// The largest image side, in pixels, the renderer library renders: a scene
+// may ask for up to kMaxImageSide x kMaxImageSide, and Camera refuses more.
+// A full frame that size is 4 GiB of float RGBA, which pvr-render (one
+// process, writing a file) can afford. It is NOT the size a session may
+// stream: frames sent to a client must also fit the wire protocol
+// (proto::checkImageSize in protocol/image_limits.h, a smaller limit),
+// which the node checks when a scene is set. The renderer does not depend
+// on protocol/, so the two limits are separate facts.
+inline constexpr int kMaxImageSide = 16384;
 
 struct ImageSpec {
   int width = 512;
@@ -82,21 +96,34 @@ struct Scene {
   ShadingSpec shading;
 };
 
-// Parses a scene document. Relative paths (volume file, ParaView preset)
-// resolve against `baseDir`. Unknown keys, wrong types and bad values throw
-// pvr::Error naming the key path ("camera.fov_y_deg: must be in (0, 180)").
+// Parses a scene document. Relative paths (volume file, ParaView preset
+// file) resolve against `baseDir`. Unknown keys, wrong types and bad values
+// throw pvr::Error naming the key path ("camera.fov_y_deg: must be in (0, 180)").
 Scene parseScene(const nlohmann::json& doc, const std::string& baseDir);
+// Reads and parses a scene file; relative paths resolve against its directory
+// and every error starts with the file's path.
 Scene loadSceneFile(const std::string& path);
-// The inverse of parseScene: every key written, defaults included.
+// The inverse of parseScene: every key written, defaults included, except
+// the values that mean "not set yet" (docs/scene.md, "Printing a scene").
 nlohmann::json sceneToJson(const Scene& scene);
 
-// Reads a ParaView transfer-function preset (JSON array of presets or one
-// preset object with "RGBPoints" and optionally "Points" for opacity) as
-// it is: colours and opacities are merged into one set of points.
-TransferFunctionSpec loadParaViewPreset(const std::string& path);
+// The "camera" section alone, read (errors name "camera.<key>") and written
+// as in a scene document; the camera read is not automatic.
+CameraSpec parseCameraSection(const nlohmann::json& section);
+nlohmann::json cameraSectionToJson(const CameraSpec& camera);
 
-// Fills what depends on the volume: unit distance, step, and the automatic
-// camera (looks at the centre from -y, tilted, the whole domain in view).
+// The camera of a scene without a "camera" section, for a width x height
+// image of `grid`: perspective, 30 degrees vertical field of view, up +z,
+// looking at the domain's centre from the -y side turned 30 degrees about
+// +z towards +x and raised 20 degrees, at the distance where the domain's
+// bounding sphere enlarged by 5 % (half a voxel for a one-node grid) fits
+// the narrower field of view. The one
+// place that computes it; docs/scene.md "camera" says the same.
+CameraSpec automaticCamera(const GridGeometry& grid, int width, int height);
+
+// Fills what depends on the volume: unit distance (the smallest spacing),
+// step (half of it) and, for an automatic camera, automaticCamera. Throws
+// pvr::Error for an invalid grid. Afterwards nothing is automatic.
 void resolveDefaults(Scene& scene, const GridGeometry& grid);
 
 }  // namespace pvr::core

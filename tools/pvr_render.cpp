@@ -42,6 +42,7 @@ int onOff(const std::string& option, const std::string& v) {
 }
 
 Args parseArgs(int argc, char** argv) {
+  using pvr::core::kMaxImageSide;
   Args a;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -51,15 +52,19 @@ Args parseArgs(int argc, char** argv) {
     };
     try {
       if (arg == "-o") a.output = value();
-      else if (arg == "--step") a.step = std::stod(value());
+      else if (arg == "--step") {
+        a.step = std::stod(value());
+        if (!(a.step > 0)) usage("--step must be > 0");
+      }
       else if (arg == "--threads") a.threads = std::stoi(value());
       else if (arg == "--frames") a.frames = std::max(1, std::stoi(value()));
       else if (arg == "--preintegrated") a.preintegrated = onOff(arg, value());
       else if (arg == "--skip") a.skip = onOff(arg, value());
       else if (arg == "--size") {
         const std::string v = value();
-        if (std::sscanf(v.c_str(), "%dx%d", &a.width, &a.height) != 2 || a.width < 1 || a.height < 1)
-          usage("--size takes WxH, not '" + v + "'");
+        if (std::sscanf(v.c_str(), "%dx%d", &a.width, &a.height) != 2 || a.width < 1 || a.height < 1 ||
+            a.width > kMaxImageSide || a.height > kMaxImageSide)
+          usage("--size takes WxH, each in 1.." + std::to_string(kMaxImageSide) + ", not '" + v + "'");
       } else if (!arg.empty() && arg[0] == '-') usage("unknown option " + arg);
       else if (a.scene.empty()) a.scene = arg;
       else usage("more than one scene file");

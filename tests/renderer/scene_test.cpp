@@ -1,5 +1,5 @@
-// Scene documents: parsing, key-path errors, printing, ParaView presets and
-// the defaults resolved from the grid.
+// Scene documents: parsing, key-path errors, printing, the image limit and
+// the defaults resolved from the grid (ParaView presets: paraview_preset_test.cpp).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "camera.h"
 #include "error.h"
 #include "scene.h"
 
@@ -208,7 +209,7 @@ TEST_CASE("unknown keys are errors naming the key path and the known keys", "[sc
       {"/fov", "fov: unknown key (known: volume, transfer_function, camera, image, sampling, shading)"},
       {"/camera/fov", "camera.fov: unknown key (known: projection, eye, look_at, up, height, fov_y_deg)"},
       {"/volume/dim", "volume.dim: unknown key (known: file, procedural, dims, spacing)"},
-      {"/transfer_function/point", "transfer_function.point: unknown key (known: points, paraview_preset, unit_distance)"},
+      {"/transfer_function/point", "transfer_function.point: unknown key (known: points, paraview_preset, paraview, unit_distance)"},
       {"/image/size", "image.size: unknown key (known: width, height, background)"},
       {"/sampling/steps", "sampling.steps: unknown key (known: step, preintegrated, early_termination)"},
       {"/shading/light", "shading.light: unknown key (known: enabled, ambient, diffuse, specular, shininess, light_direction)"},
@@ -292,9 +293,7 @@ TEST_CASE("structural errors name the section", "[scene]") {
 
   doc = baseDoc();
   doc["transfer_function"]["paraview_preset"] = "bone.json";
-  CHECK(parseError(doc) == "transfer_function: needs exactly one of 'points' or 'paraview_preset'");
-  doc["transfer_function"] = json::object();
-  CHECK(parseError(doc) == "transfer_function: needs exactly one of 'points' or 'paraview_preset'");
+  CHECK(parseError(doc).rfind("transfer_function: needs exactly one of 'points', 'paraview_preset'", 0) == 0);
 
   doc = baseDoc();
   doc["camera"]["projection"] = "orthographic";
@@ -308,7 +307,7 @@ TEST_CASE("structural errors name the section", "[scene]") {
   pvr::ErrorCode code{};
   doc = baseDoc();
   doc["transfer_function"] = {{"paraview_preset", "missing.json"}};
-  CHECK(parseError(doc, &code) == "transfer_function.paraview_preset: /base/missing.json: cannot open for reading");
+  CHECK(parseError(doc, &code) == "transfer_function.paraview_preset: /base/missing.json: no such file");
   CHECK(code == pvr::ErrorCode::kIo);
 }
 
@@ -341,7 +340,7 @@ TEST_CASE("loadSceneFile names the file in every error", "[scene]") {
     loadSceneFile(missing);
     FAIL("no error");
   } catch (const pvr::Error& e) {
-    CHECK(std::string(e.what()) == missing + ": cannot open for reading");
+    CHECK(std::string(e.what()) == missing + ": no such file");
     CHECK(e.code() == pvr::ErrorCode::kIo);
   }
 }
@@ -386,97 +385,6 @@ TEST_CASE("parseScene(sceneToJson(s)) gives back s", "[scene]") {
     CHECK_FALSE(printed["sampling"].contains("step"));
     CHECK_FALSE(printed["transfer_function"].contains("unit_distance"));
     requireSameScene(parseScene(printed, ""), s);
-  }
-}
-
-TEST_CASE("ParaView presets merge colour and opacity at the union of their scalars", "[scene]") {
-  const fs::path dir = scratchDir();
-
-  SECTION("colour and opacity knots at different scalars") {
-    // Colour knots at 0, 10, 20; opacity knots at 5, 15 (clamped outside).
-    const fs::path path = dir / "merge.json";
-    writeText(path, R"([{"Name": "t", "ColorSpace": "Diverging",
-      "RGBPoints": [0, 0, 0, 0,  10, 1, 0.5, 0,  20, 1, 1, 1],
-      "Points": [5, 0, 0.5, 0,  15, 1, 0.5, 0]}])");
-    const TransferFunctionSpec tf = loadParaViewPreset(path.string());
-    CHECK(tf.unitDistance == 0);
-    REQUIRE(tf.points.size() == 5);
-    const double expected[5][5] = {
-        {0, 0, 0, 0, 0},          {5, 0.5, 0.25, 0, 0},  {10, 1, 0.5, 0, 0.5},
-        {15, 1, 0.75, 0.5, 1},    {20, 1, 1, 1, 1},
-    };
-    for (int i = 0; i < 5; ++i) {
-      INFO("point " << i);
-      const TransferPoint& p = tf.points[i];
-      CHECK(p.scalar == expected[i][0]);
-      CHECK(p.r == Approx(expected[i][1]).margin(1e-15));
-      CHECK(p.g == Approx(expected[i][2]).margin(1e-15));
-      CHECK(p.b == Approx(expected[i][3]).margin(1e-15));
-      CHECK(p.opacity == Approx(expected[i][4]).margin(1e-15));
-    }
-  }
-
-  SECTION("one preset object without Points ramps opacity over the colour range") {
-    const fs::path path = dir / "ramp.json";
-    writeText(path, R"({"RGBPoints": [-1, 1, 0, 0,  0, 0, 1, 0,  3, 0, 0, 1]})");
-    const TransferFunctionSpec tf = loadParaViewPreset(path.string());
-    REQUIRE(tf.points.size() == 3);
-    CHECK(tf.points[0].opacity == 0);
-    CHECK(tf.points[1].opacity == Approx(0.25));
-    CHECK(tf.points[1].g == 1);
-    CHECK(tf.points[2].opacity == 1);
-  }
-
-  SECTION("a jump in colour becomes two points at one scalar") {
-    const fs::path path = dir / "jump.json";
-    writeText(path, R"([{"RGBPoints": [0, 0, 0, 0,  1, 0, 0, 0,  1, 1, 1, 1,  2, 1, 1, 1],
-                         "Points": [0, 0, 0.5, 0,  2, 1, 0.5, 0]}])");
-    const TransferFunctionSpec tf = loadParaViewPreset(path.string());
-    REQUIRE(tf.points.size() == 4);
-    CHECK(tf.points[1].scalar == 1);
-    CHECK(tf.points[1].r == 0);
-    CHECK(tf.points[1].opacity == 0.5);
-    CHECK(tf.points[2].scalar == 1);
-    CHECK(tf.points[2].r == 1);
-    CHECK(tf.points[2].opacity == 0.5);
-  }
-
-  SECTION("bad presets are errors naming the file") {
-    struct Case { const char* text; const char* message; };
-    const Case cases[] = {
-        {R"([{"Name": "x"}])", "no \"RGBPoints\""},
-        {R"([])", "empty preset array"},
-        {R"({"RGBPoints": [0, 1, 1]})", "RGBPoints: must be a non-empty array of 4-number groups"},
-        {R"({"RGBPoints": [1, 0, 0, 0, 0, 1, 1, 1]})", "RGBPoints[4]: scalar 0 is below the previous one"},
-        {R"({"RGBPoints": [0, 0, 0, 0], "Points": [0, 1.2, 0.5, 0]})", "Points: opacity 1.2 at scalar 0 is outside [0, 1]"},
-        {R"({"RGBPoints": [0, 0, -1, 0]})", "RGBPoints: colour component -1 at scalar 0 is negative"},
-        {R"({"RGBPoints": [0, 0, "x", 0]})", "RGBPoints[2]: must be a finite number"},
-        {R"("bone")", "not a ParaView preset"},
-    };
-    const fs::path path = dir / "bad_preset.json";
-    for (const Case& c : cases) {
-      INFO(c.text);
-      writeText(path, c.text);
-      try {
-        loadParaViewPreset(path.string());
-        FAIL("no error");
-      } catch (const pvr::Error& e) {
-        CHECK(std::string(e.what()).rfind(path.string() + ": " + c.message, 0) == 0);
-        CHECK(e.code() == pvr::ErrorCode::kBadFile);
-      }
-    }
-  }
-
-  SECTION("the example preset, through a scene, keeps the scene's unit distance") {
-    json doc = baseDoc();
-    doc["transfer_function"] = {{"paraview_preset", "presets/ct_bone.json"}, {"unit_distance", 0.957031}};
-    const Scene s = parseScene(doc, (kSourceRoot / "examples").string());
-    CHECK(s.transfer.unitDistance == 0.957031);
-    REQUIRE(s.transfer.points.size() == 5);
-    CHECK(s.transfer.points.front().scalar == -1024);
-    CHECK(s.transfer.points[1].opacity == 0);  // HU 200: still transparent
-    CHECK(s.transfer.points.back().scalar == 2000);
-    CHECK(s.transfer.points.back().opacity == 0.9);
   }
 }
 
@@ -539,6 +447,18 @@ TEST_CASE("resolveDefaults fills unit distance, step and the automatic camera", 
     CHECK(length(s.camera.eye - center) * std::sin(halfFovX) == Approx(1.05 * radius));
   }
 
+  SECTION("resolveDefaults and automaticCamera place the same camera") {
+    Scene s = parseScene(json::parse(R"({"volume": {"procedural": "shepp-logan"}, "image": {"width": 300, "height": 100}})"), "");
+    resolveDefaults(s, grid);
+    const CameraSpec a = automaticCamera(grid, 300, 100);
+    CHECK(s.camera.eye == a.eye);
+    CHECK(s.camera.lookAt == a.lookAt);
+    CHECK(s.camera.up == a.up);
+    CHECK(s.camera.fovYDeg == a.fovYDeg);
+    CHECK(s.camera.projection == a.projection);
+    CHECK_FALSE(a.automatic);
+  }
+
   SECTION("given values are kept") {
     Scene s = parseScene(baseDoc(), "");
     const CameraSpec before = s.camera;
@@ -555,5 +475,41 @@ TEST_CASE("resolveDefaults fills unit distance, step and the automatic camera", 
     resolveDefaults(s, point);
     CHECK(length(s.camera.eye - s.camera.lookAt) > 0);
     CHECK(s.sampling.step == 0.5);
+  }
+}
+
+TEST_CASE("the renderer's image limit: scenes and cameras refuse a side beyond kMaxImageSide", "[scene]") {
+  json doc = baseDoc();
+  doc["image"]["width"] = kMaxImageSide;
+  CHECK(parseScene(doc, "").image.width == kMaxImageSide);
+  doc["image"]["width"] = kMaxImageSide + 1;
+  CHECK(parseError(doc) == "image.width: must be in 1.." + std::to_string(kMaxImageSide) + ", got " +
+                               std::to_string(kMaxImageSide + 1));
+
+  // A program that sizes the image itself (pvr-render --size) meets the same limit in Camera.
+  const CameraSpec spec = parseScene(baseDoc(), "").camera;
+  CHECK(Camera(spec, kMaxImageSide, 1).width() == kMaxImageSide);
+  for (const auto& [w, h] : {std::pair{kMaxImageSide + 1, 1}, std::pair{1, kMaxImageSide + 1}, std::pair{0, 1}}) {
+    try {
+      Camera(spec, w, h);
+      FAIL("no error for " << w << " x " << h);
+    } catch (const pvr::Error& e) {
+      CHECK(std::string(e.what()) == "camera: image of " + std::to_string(w) + " x " + std::to_string(h) +
+                                         " pixels: each side must be in 1.." + std::to_string(kMaxImageSide));
+    }
+  }
+}
+
+TEST_CASE("parseCameraSection(cameraSectionToJson(c)) gives back c", "[scene]") {
+  for (const CameraSpec& c : {CameraSpec{Projection::kOrthographic, {1, 2, 3}, {0, 0.5, 0}, {0, 0, 1}, 4.5, 30, false},
+                              CameraSpec{Projection::kPerspective, {0, -3, 0}, {0, 0, 0}, {1, 0, 1}, 0, 12.5, false}}) {
+    const CameraSpec back = parseCameraSection(json::parse(cameraSectionToJson(c).dump()));
+    CHECK(back.projection == c.projection);
+    CHECK(back.eye == c.eye);
+    CHECK(back.lookAt == c.lookAt);
+    CHECK(back.up == c.up);
+    CHECK(back.height == c.height);
+    CHECK(back.fovYDeg == c.fovYDeg);
+    CHECK_FALSE(back.automatic);
   }
 }

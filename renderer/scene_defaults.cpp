@@ -1,0 +1,47 @@
+// The values a scene leaves to the volume: unit distance, step and the
+// automatic camera (docs/scene.md, "Defaults that need the volume").
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "scene.h"
+
+namespace pvr::core {
+
+CameraSpec automaticCamera(const GridGeometry& grid, int width, int height) {
+  constexpr double kFovYDeg = 30, kElevationDeg = 20, kAzimuthDeg = 30, kMargin = 1.05;
+  constexpr double kDeg = std::numbers::pi / 180;
+
+  // Fit the domain's bounding sphere, plus a margin, into the narrower of
+  // the two fields of view. A one-node domain is a point: give it half a voxel.
+  const double radius =
+      kMargin * std::max(0.5 * length(grid.domainMax() - grid.domainMin()), 0.5 * grid.minSpacing());
+  const double halfFovY = 0.5 * kFovYDeg * kDeg;
+  const double aspect = double(width) / double(height);
+  const double halfFovX = std::atan(std::tan(halfFovY) * aspect);
+  const double distance = radius / std::sin(std::min(halfFovY, halfFovX));
+
+  // From the -y side, turned by the azimuth about +z towards +x, raised by the elevation.
+  const double el = kElevationDeg * kDeg, az = kAzimuthDeg * kDeg;
+  const Vec3 towardsEye{std::cos(el) * std::sin(az), -std::cos(el) * std::cos(az), std::sin(el)};
+
+  CameraSpec cam;
+  cam.projection = Projection::kPerspective;
+  cam.fovYDeg = kFovYDeg;
+  cam.lookAt = grid.center();
+  cam.eye = cam.lookAt + towardsEye * distance;
+  cam.up = {0, 0, 1};
+  cam.height = 0;
+  cam.automatic = false;
+  return cam;
+}
+
+void resolveDefaults(Scene& scene, const GridGeometry& grid) {
+  grid.validate("volume");
+  const double voxel = grid.minSpacing();
+  if (scene.transfer.unitDistance == 0) scene.transfer.unitDistance = voxel;
+  if (scene.sampling.step == 0) scene.sampling.step = 0.5 * voxel;
+  if (scene.camera.automatic) scene.camera = automaticCamera(grid, scene.image.width, scene.image.height);
+}
+
+}  // namespace pvr::core

@@ -1,0 +1,35 @@
+// The sections of a scene document, each read and written by one pair of
+// functions (parseScene and sceneToJson call them). Internal to the
+// renderer; the camera's pair is public (scene.h). Readers throw
+// pvr::Error naming the key path (scene_json.h); writers write every key
+// of their section, except the values that mean "not set yet" (docs/scene.md,
+// "Printing a scene").
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "scene.h"
+
+namespace pvr::core {
+
+// "volume": relative file paths resolve against baseDir.
+VolumeSpec parseVolume(const nlohmann::json& section, const std::string& baseDir);
+nlohmann::json volumeToJson(const VolumeSpec& volume);
+
+// "transfer_function": points, a ParaView preset file (relative to baseDir)
+// or an inline preset; defaultTransfer() is the scene without the section.
+TransferFunctionSpec parseTransfer(const nlohmann::json& section, const std::string& baseDir);
+TransferFunctionSpec defaultTransfer();
+nlohmann::json transferToJson(const TransferFunctionSpec& transfer);
+
+// "image", "sampling", "shading": how to render.
+ImageSpec parseImage(const nlohmann::json& section);
+nlohmann::json imageToJson(const ImageSpec& image);
+SamplingSpec parseSampling(const nlohmann::json& section);
+nlohmann::json samplingToJson(const SamplingSpec& sampling);
+ShadingSpec parseShading(const nlohmann::json& section);
+nlohmann::json shadingToJson(const ShadingSpec& shading);
+
+}  // namespace pvr::core

@@ -1,0 +1,60 @@
+// The scene's "volume" section: a volume file or a procedural volume.
+#include <algorithm>
+
+#include "io/volume_io.h"
+#include "scene_json.h"
+#include "scene_sections.h"
+
+namespace pvr::core {
+
+using namespace scene_json;
+
+VolumeSpec parseVolume(const json& v, const std::string& baseDir) {
+  const std::string path = "volume";
+  requireObject(v, path, {"file", "procedural", "dims", "spacing"});
+  VolumeSpec spec;
+  if (exactlyOneOf(v, path, {"file", "procedural"},
+                   "'file' (a volume file) or 'procedural' (a generated volume)") == "file") {
+    for (const char* key : {"dims", "spacing"})
+      if (find(v, key)) fail(childPath(path, key), "only for a procedural volume (a file carries its own)");
+    spec.file = asString(v["file"], path + ".file");
+    if (spec.file.empty()) fail(path + ".file", "must not be empty");
+    spec.file = resolvePath(spec.file, baseDir);
+    return spec;
+  }
+
+  spec.procedural = asString(v["procedural"], path + ".procedural");
+  const std::vector<std::string> names = proceduralNames();
+  if (std::find(names.begin(), names.end(), spec.procedural) == names.end())
+    fail(path + ".procedural",
+         "unknown procedural volume '" + spec.procedural + "' (known: " + joinNames(names) + ")");
+  if (const json* dims = find(v, "dims")) {
+    const std::string p = path + ".dims";
+    if (!dims->is_array() || dims->size() != 3)
+      fail(p, "must be an array of 3 integers, got " + describeValue(*dims));
+    for (int a = 0; a < 3; ++a) {
+      const std::int64_t d = asInteger((*dims)[a], indexPath(p, a));
+      if (d < 1 || d > INT32_MAX)
+        fail(indexPath(p, a), "must be in 1.." + std::to_string(INT32_MAX) + ", got " + std::to_string(d));
+      spec.dims[a] = d;
+    }
+  }
+  if (const json* spacing = find(v, "spacing")) {
+    const std::string p = path + ".spacing";
+    const Vec3 s = asVec3(*spacing, p);
+    for (int a = 0; a < 3; ++a)
+      if (!(s[a] > 0)) fail(indexPath(p, a), "must be > 0, got " + numberText(s[a]));
+    spec.spacing = s;
+  }
+  return spec;
+}
+
+json volumeToJson(const VolumeSpec& volume) {
+  if (!volume.file.empty()) return {{"file", volume.file}};
+  json out = {{"procedural", volume.procedural},
+              {"dims", json::array({volume.dims.x, volume.dims.y, volume.dims.z})}};
+  if (volume.spacing) out["spacing"] = toJson(*volume.spacing);
+  return out;
+}
+
+}  // namespace pvr::core
