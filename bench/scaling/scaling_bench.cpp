@@ -189,7 +189,8 @@ int main(int argc, char** argv) {
   for (const auto& c : memory["clusters"])
     for (const auto& b : c["bytes_per_rank"]) {
       most = std::max(most, b.get<std::uint64_t>());
-      perRank += (perRank.empty() ? "" : " ") + std::to_string(b.get<std::uint64_t>());
+      if (!perRank.empty()) perRank += ' ';
+      perRank += std::to_string(b.get<std::uint64_t>());
     }
   std::printf("%s,%d,%s,%d,%d,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%llu,%s\n", label.c_str(), np,
               layout.empty() ? "default" : layout.c_str(), frames, size, perFrame, sum[0] / frames, sum[1] / frames,
