@@ -12,35 +12,23 @@
 #include "error.h"
 #include "paraview_preset.h"
 #include "scene.h"
+#include "test_files.h"
 
 using namespace pvr::core;
+using namespace pvr::core::test;
 using nlohmann::json;
 namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kSourceRoot = fs::path(__FILE__).parent_path().parent_path().parent_path();
-
-fs::path scratchDir() {
-  const fs::path dir = fs::path(PVR_TEST_TMP) / "paraview_preset";
-  fs::create_directories(dir);
-  return dir;
-}
-
-void writeText(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  REQUIRE(out.good());
-}
-
 json sceneWithTransfer(const json& transfer) {
   return {{"volume", {{"procedural", "shepp-logan"}}}, {"transfer_function", transfer}};
 }
 
-// The transfer function of a scene naming `presetText` through a file.
-TransferFunctionSpec throughFile(const std::string& presetText, const std::string& name) {
-  writeText(scratchDir() / name, presetText);
-  return parseScene(sceneWithTransfer({{"paraview_preset", name}}), scratchDir().string()).transfer;
+// The transfer function of a scene naming `presetText` through a file in `dir`.
+TransferFunctionSpec throughFile(const std::string& presetText, const fs::path& dir, const std::string& name) {
+  writeText(dir / name, presetText);
+  return parseScene(sceneWithTransfer({{"paraview_preset", name}}), dir.string()).transfer;
 }
 
 // The same preset inline.
@@ -132,10 +120,11 @@ TEST_CASE("inline and file presets give identical transfer functions", "[scene][
       R"({"RGBPoints": [0, 0, 0, 0,  1, 0, 0, 0,  1, 1, 1, 1,  2, 1, 1, 1]})",
       R"({"RGBPoints": [0.1, 0.3, 0.7, 0.2], "Points": [0.1, 0.123456789, 0.5, 0]})",
   };
+  const fs::path dir = scratchDir("preset_inline_and_file");
   int n = 0;
   for (const std::string& text : presets) {
     INFO(text);
-    requireSameTransfer(throughFile(text, "same_" + std::to_string(n++) + ".json"), inlined(text));
+    requireSameTransfer(throughFile(text, dir, "same_" + std::to_string(n++) + ".json"), inlined(text));
   }
 
   // The example preset, read as pvrsh -tfpreset sends it, with a unit distance beside it.
@@ -178,7 +167,7 @@ TEST_CASE("a malformed preset is an error naming the key path, inline and in a f
       {R"({"RGBPoints": [0, 0, 0, 0], "Points": "linear"})", "Points",
        "must be a non-empty array of groups of 4 numbers, got string \"linear\""},
   };
-  const fs::path file = scratchDir() / "bad.json";
+  const fs::path file = fs::path(scratchDir("preset_malformed")) / "bad.json";
   for (const Case& c : cases) {
     INFO(c.text);
     const std::string at = c.at;
@@ -208,7 +197,8 @@ TEST_CASE("a malformed preset is an error naming the key path, inline and in a f
 }
 
 TEST_CASE("a preset file that cannot be read names the file", "[scene][preset]") {
-  const fs::path notJson = scratchDir() / "not_json.json";
+  const fs::path dir = scratchDir("preset_unreadable");
+  const fs::path notJson = dir / "not_json.json";
   writeText(notJson, "[{\"RGBPoints\": ");
   try {
     loadParaViewPreset(notJson.string());
@@ -218,9 +208,9 @@ TEST_CASE("a preset file that cannot be read names the file", "[scene][preset]")
     CHECK(e.code() == pvr::ErrorCode::kBadFile);
   }
 
-  const std::string missing = (scratchDir() / "no_such_preset.json").string();
+  const std::string missing = (dir / "no_such_preset.json").string();
   try {
-    parseScene(sceneWithTransfer({{"paraview_preset", "no_such_preset.json"}}), scratchDir().string());
+    parseScene(sceneWithTransfer({{"paraview_preset", "no_such_preset.json"}}), dir.string());
     FAIL("no error");
   } catch (const pvr::Error& e) {
     CHECK(std::string(e.what()) == "transfer_function.paraview_preset: " + missing + ": no such file");

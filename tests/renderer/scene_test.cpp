@@ -14,34 +14,14 @@
 #include "camera.h"
 #include "error.h"
 #include "scene.h"
+#include "test_files.h"
 
 using namespace pvr::core;
+using namespace pvr::core::test;
 using nlohmann::json;
 namespace fs = std::filesystem;
 
 namespace {
-
-const fs::path kSourceRoot = fs::path(__FILE__).parent_path().parent_path().parent_path();
-
-fs::path scratchDir() {
-  const fs::path dir = fs::path(PVR_TEST_TMP) / "scene";
-  fs::create_directories(dir);
-  return dir;
-}
-
-void writeText(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  REQUIRE(out.good());
-}
-
-std::string readText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  REQUIRE(in.good());
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // The JSON block under "## A full example" in docs/scene.md, so the
 // documentation's example is the one the tests parse.
@@ -312,7 +292,7 @@ TEST_CASE("structural errors name the section", "[scene]") {
 }
 
 TEST_CASE("loadSceneFile names the file in every error", "[scene]") {
-  const fs::path dir = scratchDir();
+  const fs::path dir = scratchDir("scene_load_errors");
   const std::string bad = (dir / "bad_key.json").string();
   json doc = baseDoc();
   doc["camera"]["fov"] = 30;

@@ -17,6 +17,7 @@
 
 #include "error.h"
 #include "io/volume_io.h"
+#include "test_files.h"
 
 namespace pvr::core::test {
 
@@ -24,14 +25,6 @@ namespace fs = std::filesystem;
 
 constexpr ScalarType kAllTypes[] = {ScalarType::kUInt8, ScalarType::kUInt16, ScalarType::kInt16,
                                     ScalarType::kFloat32};
-
-// A fresh, empty scratch directory for one test.
-inline std::string scratchDir(const std::string& name) {
-  const fs::path dir = fs::path(PVR_TEST_TMP) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir.string();
-}
 
 struct TestVolume {
   GridGeometry grid;
