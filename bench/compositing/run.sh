@@ -53,6 +53,12 @@ plot_lines() {  # size codec column
   echo "$cmd"
 }
 
+breakdown_lines() {  # strategy: dist, rend, comp, comm, send of 512 x 512 RLE
+  echo "'$data/512-$1-rle.dat' using 1:10 with linespoints title 'dist', '' using 1:11 with linespoints title 'rend'," \
+       "'' using 1:7 with linespoints title 'comp', '' using 1:8 with linespoints title 'comm'," \
+       "'' using 1:9 with linespoints title 'send'"
+}
+
 gnuplot <<GNUPLOT
 set datafile separator ','
 set terminal pngcairo size 1100,450 font ',10'
@@ -95,17 +101,9 @@ set ylabel 'seconds (log scale)'
 set logscale y
 set key bottom right
 set title 'binary-swap'
-plot '$data/512-binary-swap-rle.dat' using 1:10 with linespoints title 'dist', \
-     '' using 1:11 with linespoints title 'rend', \
-     '' using 1:7 with linespoints title 'comp', \
-     '' using 1:8 with linespoints title 'comm', \
-     '' using 1:9 with linespoints title 'send'
+plot $(breakdown_lines binary-swap)
 set title 'tree'
-plot '$data/512-tree-rle.dat' using 1:10 with linespoints title 'dist', \
-     '' using 1:11 with linespoints title 'rend', \
-     '' using 1:7 with linespoints title 'comp', \
-     '' using 1:8 with linespoints title 'comm', \
-     '' using 1:9 with linespoints title 'send'
+plot $(breakdown_lines tree)
 unset multiplot
 GNUPLOT
 echo "wrote $out/compositing.csv, memory.csv and PNGs"
