@@ -6,10 +6,7 @@
 // Writes OUT_DIR/<name>/<name>.raw and <name>.json (float32, N^3).
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "error.h"
 #include "io/volume_io.h"
@@ -29,22 +26,9 @@ int main(int argc, char** argv) {
 
     std::string stem = name;
     for (char& c : stem) c = c == '-' ? '_' : c;
-    const std::filesystem::path dir = std::filesystem::path(argv[3]) / stem;
-    std::filesystem::create_directories(dir);
-    const std::filesystem::path raw = dir / (stem + ".raw");
-    std::ofstream(raw, std::ios::binary)
-        .write(reinterpret_cast<const char*>(volume.bytes()), std::streamsize(volume.byteSize()));
-    const GridGeometry& g = volume.grid();
-    const nlohmann::json sidecar = {
-        {"dims", {g.dims.x, g.dims.y, g.dims.z}},
-        {"dtype", std::string(scalarName(volume.type()))},
-        {"spacing", {g.spacing.x, g.spacing.y, g.spacing.z}},
-        {"origin", {g.origin.x, g.origin.y, g.origin.z}},
-        {"raw_file", raw.filename().string()},
-        {"endian", "little"},
-        {"description", "procedural " + name + " volume written by pvr-make-volume"}};
-    std::ofstream(dir / (stem + ".json")) << sidecar.dump(2) << "\n";
-    std::printf("%s\n", (dir / (stem + ".json")).c_str());
+    const std::string sidecar = writeRawJsonVolume(volume, (std::filesystem::path(argv[3]) / stem).string(), stem,
+                                                   "procedural " + name + " volume written by pvr-make-volume");
+    std::printf("%s\n", sidecar.c_str());
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pvr-make-volume: %s\n", e.what());

@@ -4,8 +4,11 @@
 //    "raw_file": "<name>.raw"          (optional, default: the .raw beside the sidecar),
 //    "endian": "little" | "big"        (optional, default little), ...}
 // Other keys (provenance, licence, statistics) are ignored. Either file may
-// be given: a .raw finds its sidecar beside it, <stem>.json.
+// be given: a .raw finds its sidecar beside it, <stem>.json. The writer of
+// the same form is here too.
+#include <bit>
 #include <filesystem>
+#include <fstream>
 
 #include "formats.h"
 #include "json_file.h"
@@ -111,6 +114,36 @@ std::unique_ptr<VolumeSource> openRawJson(const std::string& path) {
   layout.headerPath = jsonPath;
   layout.bigEndian = readBigEndian(doc, jsonPath);
   return openRawVolume(fileNameOf(path), grid, type, std::move(layout), SizeRule::kExact);
+}
+
+std::string writeRawJsonVolume(const Brick& volume, const std::string& dir, const std::string& stem,
+                               const std::string& description) {
+  const GridGeometry& g = volume.grid();
+  if (volume.stored() != g.allNodes())
+    throw Error(ErrorCode::kInternal, "writeRawJsonVolume: the brick must store the whole grid");
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) failAt(ErrorCode::kIo, dir, "cannot create the directory: " + ec.message());
+
+  const fs::path raw = fs::path(dir) / (stem + ".raw");
+  std::ofstream rawOut(raw, std::ios::binary);
+  rawOut.write(reinterpret_cast<const char*>(volume.bytes()), std::streamsize(volume.byteSize()));
+  rawOut.close();
+  if (!rawOut) failAt(ErrorCode::kIo, raw.string(), "cannot write");
+
+  const json sidecar = {{"dims", {g.dims.x, g.dims.y, g.dims.z}},
+                        {"dtype", std::string(scalarName(volume.type()))},
+                        {"spacing", {g.spacing.x, g.spacing.y, g.spacing.z}},
+                        {"origin", {g.origin.x, g.origin.y, g.origin.z}},
+                        {"raw_file", raw.filename().string()},
+                        {"endian", std::endian::native == std::endian::big ? "big" : "little"},
+                        {"description", description}};
+  const fs::path jsonPath = fs::path(dir) / (stem + ".json");
+  std::ofstream jsonOut(jsonPath);
+  jsonOut << sidecar.dump(2) << "\n";
+  jsonOut.close();
+  if (!jsonOut) failAt(ErrorCode::kIo, jsonPath.string(), "cannot write");
+  return jsonPath.string();
 }
 
 }  // namespace pvr::core

@@ -48,6 +48,15 @@ const std::vector<VolumeFormat>& volumeFormats();
 // dims that do not match the byte count).
 std::unique_ptr<VolumeSource> openVolumeFile(const std::string& path);
 
+// Writes a whole volume (a brick whose stored box is the whole grid) in the
+// raw + JSON sidecar form of ../shared/data that openVolumeFile reads back:
+// DIR/STEM.raw (the voxels in this machine's byte order) and DIR/STEM.json
+// (dims, dtype, spacing, origin, raw_file, endian, and `description`),
+// creating DIR. Returns the sidecar's path; throws pvr::Error(kIo) naming the
+// file that could not be written.
+std::string writeRawJsonVolume(const Brick& volume, const std::string& dir, const std::string& stem,
+                               const std::string& description);
+
 // Procedural volumes by name, any resolution, float32 values:
 //   "shepp-logan"     3D Shepp-Logan head phantom (Kak & Slaney ellipsoids), values in [0, 1]
 //   "marschner-lobb"  the Marschner-Lobb test signal (f_M = 6, alpha = 0.25) on [-1,1]^3, values in [0, 1]

@@ -220,3 +220,17 @@ TEST_CASE("openVolumeFile lists the formats it knows", "[io]") {
   CHECK(volumeFormats()[2].matches("brain.nii.gz"));
   CHECK_FALSE(volumeFormats()[0].matches("brain.nii.gz"));
 }
+
+TEST_CASE("writeRawJsonVolume writes what openVolumeFile reads back, voxel for voxel", "[io]") {
+  const std::string dir = scratchDir("write_raw_json");
+  const Brick written = openProcedural("shepp-logan", {9, 7, 5}, Vec3{0.5, 0.25, 2})->readAll();
+  const std::string sidecar = writeRawJsonVolume(written, dir + "/sub", "phantom", "a test volume");
+  CHECK(sidecar == dir + "/sub/phantom.json");
+  const Brick read = openVolumeFile(sidecar)->readAll();
+  CHECK(read.type() == written.type());
+  CHECK(read.grid().dims == written.grid().dims);
+  CHECK(read.grid().spacing == written.grid().spacing);
+  CHECK(read.grid().origin == written.grid().origin);
+  REQUIRE(read.byteSize() == written.byteSize());
+  CHECK(std::memcmp(read.bytes(), written.bytes(), read.byteSize()) == 0);
+}
