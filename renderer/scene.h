@@ -56,12 +56,13 @@ struct CameraSpec {
 
 // The largest image side, in pixels, the renderer library renders: a scene
 // may ask for up to kMaxImageSide x kMaxImageSide, and Camera refuses more.
-// A full frame that size is 4 GiB of float RGBA, which pvr-render (one
-// process, writing a file) can afford. It is NOT the size a session may
-// stream: frames sent to a client must also fit the wire protocol
-// (proto::checkImageSize in protocol/image_limits.h, a smaller limit),
-// which the node checks when a scene is set. The renderer does not depend
-// on protocol/, so the two limits are separate facts.
+// A full frame that size is 4 GiB of float RGBA, for pvr-render (one
+// process, writing a file). It is NOT the size a session may stream: frames
+// sent to a client must also fit the wire protocol (proto::checkImageSize
+// in protocol/image_limits.h, a smaller limit), which the node checks when
+// a scene is set; and images exchanged between ranks must fit the sparse
+// image codec (kImageCodecMaxPixels, image_codec.h). The renderer does not
+// depend on protocol/, so these are separate facts.
 inline constexpr int kMaxImageSide = 16384;
 
 struct ImageSpec {
