@@ -5,8 +5,7 @@
 // slowest counts). Every rank ends with the same Calibration.
 #include <chrono>
 
-#include "../node.h"
-#include "../wave_io.h"
+#include "table.h"
 
 namespace pvr::node::actions {
 
@@ -31,7 +30,7 @@ double pingPong(comm::Communicator& world, int peer, std::size_t bytes, int roun
 
 }  // namespace
 
-void calibrate(NodeState& state, const ActionArgs&) {
+void Calibrate::run(NodeState& state, const Calibrate&) {
   comm::Communicator& world = state.world;
   const int peer = world.size() - 1;
   std::vector<double> measured(3, 0.0);  // latency, seconds per byte, seconds per pixel
