@@ -16,13 +16,11 @@
 #include <vector>
 
 #include "brick.h"
-#include "camera.h"
 #include "command_channel.h"
 #include "communicator.h"
 #include "decompose/kd_tree.h"
 #include "distribute.h"
 #include "image.h"
-#include "image_codec.h"
 #include "io/volume_io.h"
 #include "layout.h"
 #include "pvr_protocol.h"

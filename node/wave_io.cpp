@@ -1,7 +1,6 @@
 #include "wave_io.h"
 
 #include <algorithm>
-#include <cstring>
 
 namespace pvr::node {
 

@@ -13,7 +13,6 @@
 #include "communicator.h"
 #include "image.h"
 #include "image_codec.h"
-#include "scene.h"
 
 namespace pvr::node {
 

@@ -1,6 +1,6 @@
-// comp_latency: per compositing cluster (render
-// clusters that composite themselves, and composite clusters), the latency
-// model's estimate beside the measured mean compositing time per frame.
+// comp_latency: per compositing cluster (render clusters that composite
+// themselves, and composite clusters), the latency model's estimate beside
+// the measured mean compositing time per frame, into state.reply.
 //
 // Model, calibrated by the calibrate action: a rank's compositing time is
 // messages * latency + bytes / bandwidth + pixels / blend rate, over the

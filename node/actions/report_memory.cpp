@@ -1,6 +1,6 @@
-// report_memory: dataset bytes each rank holds
-// (its brick: owned nodes plus ghost layers), per cluster. The master
-// keeps the answer in state.reply for "performance memory cluster".
+// report_memory: dataset bytes each rank holds (its brick: owned nodes plus
+// ghost layers), per cluster. The master keeps the answer in state.reply
+// for "performance memory cluster".
 #include "table.h"
 
 namespace pvr::node::actions {

@@ -154,6 +154,11 @@ class Job {
     REQUIRE(std::holds_alternative<proto::ErrorMessage>(d->message));
     return std::get<proto::ErrorMessage>(d->message);
   }
+  // Closes the session; true if the job then ended by itself within 30 s.
+  bool close() {
+    send(proto::Close{"done"});
+    return reap(30);
+  }
   // Waits for mpirun to exit; true if it did within `seconds`.
   bool reap(int seconds) {
     const auto until = Clock::now() + std::chrono::seconds(seconds);
@@ -360,8 +365,7 @@ TEST_CASE_METHOD(Fixture, "clusters, groups and a compositing cluster all render
     const Reference narrowRef(nlohmann::json::parse(narrow));
     CHECK(core::maxAbsDifference(dumped(job, id, 0), narrowRef.frame(0, 1)) <= 1e-5);
   }
-  job.send(proto::Close{"done"});
-  CHECK(job.reap(30));
+  CHECK(job.close());
 }
 
 TEST_CASE_METHOD(Fixture, "a failure on a rank that sends to a compositing cluster, or on a compositing rank, reaches the client") {
@@ -383,8 +387,7 @@ TEST_CASE_METHOD(Fixture, "a failure on a rank that sends to a compositing clust
   CHECK_THAT(job.expectError().text, Catch::Contains("rank 2: injected failure in composite"));
   const auto id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 2, 12});
   checkSequence(job, id, 3, 12, ref);
-  job.send(proto::Close{"done"});
-  CHECK(job.reap(30));
+  CHECK(job.close());
 }
 
 TEST_CASE_METHOD(Fixture, "scene patches are checked whole before and after the dataset, and status reports the session") {
@@ -450,8 +453,7 @@ TEST_CASE_METHOD(Fixture, "scene patches are checked whole before and after the 
   for (const auto& p : scene.transfer.points) points.insert(points.end(), {p.scalar, p.r, p.g, p.b, p.opacity});
   CHECK(points.size() == 20);
   CHECK(numbers(status["transfer_function"]) == points);
-  job.send(proto::Close{"done"});
-  CHECK(job.reap(30));
+  CHECK(job.close());
 }
 
 TEST_CASE_METHOD(Fixture, "a rank killed mid-sequence: the handler side sees the end and nothing is left running") {
