@@ -53,7 +53,6 @@ struct Calibration {
   double latency = 0;        // seconds per message, one way
   double bandwidth = 0;      // bytes per second
   double blendRate = 0;      // pixels "over" per second
-  bool measured = false;
 };
 
 struct NodeState {

@@ -55,7 +55,6 @@ void Calibrate::run(NodeState& state, const Calibrate&) {
   state.calibration.latency = measured[0];
   state.calibration.bandwidth = measured[1] > 0 ? 1.0 / measured[1] : 0.0;
   state.calibration.blendRate = measured[2] > 0 ? 1.0 / measured[2] : 0.0;
-  state.calibration.measured = true;
 }
 
 }  // namespace pvr::node::actions
