@@ -25,45 +25,6 @@ void requireDataset(const NodeState& state) {
 
 }  // namespace
 
-Master::Master(NodeState& state, PvrdLink& link) : state_(state), link_(link) {
-  using proto::FrameInfo;
-  dispatcher_.on<proto::Hello>([this](const proto::Hello&, const FrameInfo& info) {
-    send(proto::Welcome{"pvr-node 0.2", std::uint32_t(state_.world.size()), false}, info.requestId);
-  });
-  dispatcher_.on<proto::SessionOpen>(
-      [this](const proto::SessionOpen& m, const FrameInfo& info) { layout(m.clusters, info.requestId); });
-  dispatcher_.on<proto::SetLayout>(
-      [this](const proto::SetLayout& m, const FrameInfo& info) { layout(m.clusters, info.requestId); });
-  dispatcher_.on<proto::StatusRequest>([this](const proto::StatusRequest&, const FrameInfo& info) {
-    send(proto::StatusReply{statusEntries(state_, {running_ != 0, framesSent_, scene_.settings})}, info.requestId);
-  });
-  dispatcher_.on<proto::SetScene>(
-      [this](const proto::SetScene& m, const FrameInfo& info) { setScene(m, info.requestId); });
-  dispatcher_.on<proto::RenderFrame>([this](const proto::RenderFrame&, const FrameInfo& info) {
-    requireDataset(state_);
-    const core::CameraSpec camera = state_.scene.camera;
-    renderSequence(1, [&](int) { return camera; }, info.requestId);
-  });
-  dispatcher_.on<proto::RenderRotation>([this](const proto::RenderRotation& m, const FrameInfo& info) {
-    const Rotation rotation(state_.scene.camera, m);
-    requireDataset(state_);
-    renderSequence(rotation.frames(), [&](int k) { return rotation.camera(k); }, info.requestId);
-  });
-  dispatcher_.on<proto::PerformanceRequest>(
-      [this](const proto::PerformanceRequest& m, const FrameInfo& info) { performance(m, info.requestId); });
-  dispatcher_.on<proto::Cancel>([this](const proto::Cancel& m, const FrameInfo& info) {
-    // Requests run one at a time: any target but the running one has finished.
-    if (running_ != 0 && m.target == running_) cancelled_ = true;
-    send(proto::Ok{}, info.requestId);
-  });
-  dispatcher_.on<proto::Close>([this](const proto::Close&, const FrameInfo&) { link_.close(); });
-  dispatcher_.otherwise([this](const proto::Message& m, const FrameInfo& info) {
-    const auto name = std::visit([](const auto& message) { return std::decay_t<decltype(message)>::kWire.name; }, m);
-    send(proto::ErrorMessage{ErrorCode::kUnsupported, std::string(name) + " is not served by pvr-node"},
-         info.requestId);
-  });
-}
-
 void Master::serve() {
   while (link_.open()) {
     std::optional<proto::Decoded> frame;
@@ -80,7 +41,7 @@ void Master::serve() {
 
 void Master::handle(const proto::Decoded& frame) {
   try {
-    dispatcher_.dispatch(frame);
+    std::visit([&](const auto& m) { on(m, frame.info.requestId); }, frame.message);
   } catch (const Error& e) {
     sendError(wireError(e), frame.info.requestId);
   } catch (const std::exception& e) {
@@ -88,12 +49,20 @@ void Master::handle(const proto::Decoded& frame) {
   }
 }
 
+void Master::on(const proto::Hello&, std::uint32_t id) {
+  send(proto::Welcome{"pvr-node 0.2", std::uint32_t(state_.world.size()), false}, id);
+}
+
+void Master::on(const proto::SessionOpen& m, std::uint32_t id) { layout(m.clusters, id); }
+
+void Master::on(const proto::SetLayout& m, std::uint32_t id) { layout(m.clusters, id); }
+
 void Master::layout(const std::vector<proto::ClusterSpec>& clusters, std::uint32_t id) {
   if (auto f = invoke(state_, actions::SetLayout{clusters})) return sendError(wireError(*f), id);
   send(proto::SessionReady{std::uint32_t(state_.world.size()), state_.layout.specs()}, id);
 }
 
-void Master::setScene(const proto::SetScene& request, std::uint32_t id) {
+void Master::on(const proto::SetScene& request, std::uint32_t id) {
   auto patched = patchScene(scene_, request, state_.dataDir);
   if (const auto* refused = std::get_if<proto::ProtocolError>(&patched)) return sendError(*refused, id);
   SessionScene& next = std::get<SessionScene>(patched);
@@ -106,12 +75,41 @@ void Master::setScene(const proto::SetScene& request, std::uint32_t id) {
   send(proto::Ok{}, id);
 }
 
-void Master::performance(const proto::PerformanceRequest& p, std::uint32_t id) {
+void Master::on(const proto::StatusRequest&, std::uint32_t id) {
+  send(proto::StatusReply{statusEntries(state_, {running_ != 0, framesSent_, scene_.settings})}, id);
+}
+
+void Master::on(const proto::RenderFrame&, std::uint32_t id) {
+  requireDataset(state_);
+  const core::CameraSpec camera = state_.scene.camera;
+  renderSequence(1, [&](int) { return camera; }, id);
+}
+
+void Master::on(const proto::RenderRotation& m, std::uint32_t id) {
+  const Rotation rotation(state_.scene.camera, m);
+  requireDataset(state_);
+  renderSequence(rotation.frames(), [&](int k) { return rotation.camera(k); }, id);
+}
+
+void Master::on(const proto::PerformanceRequest& p, std::uint32_t id) {
   const std::int32_t cluster = p.cluster == proto::kAllClusters ? -1 : std::int32_t(p.cluster);
   const auto failure = p.query == proto::PerformanceQuery::kMemory ? invoke(state_, actions::ReportMemory{cluster})
                                                                     : invoke(state_, actions::CompLatency{cluster});
   if (failure) return sendError(wireError(*failure), id);
   send(proto::PerformanceReply{p.query, state_.reply.dump()}, id);
+}
+
+void Master::on(const proto::Cancel& m, std::uint32_t id) {
+  // Requests run one at a time: any target but the running one has finished.
+  if (running_ != 0 && m.target == running_) cancelled_ = true;
+  send(proto::Ok{}, id);
+}
+
+void Master::on(const proto::Close&, std::uint32_t) { link_.close(); }
+
+template <class M>
+void Master::on(const M&, std::uint32_t id) {
+  send(proto::ErrorMessage{ErrorCode::kUnsupported, std::string(M::kWire.name) + " is not served by pvr-node"}, id);
 }
 
 void Master::renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf, std::uint32_t id) {

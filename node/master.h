@@ -18,24 +18,38 @@ namespace pvr::node {
 
 class Master {
  public:
-  Master(NodeState& state, PvrdLink& link);
+  Master(NodeState& state, PvrdLink& link) : state_(state), link_(link) {}
   // Serves until the link closes or the client sends Close.
   void serve();
 
  private:
   void send(const proto::Message& m, std::uint32_t id, bool final = true) { link_.send(m, id, final); }
   void sendError(const proto::ProtocolError& e, std::uint32_t id) { send(proto::ErrorMessage{e.code, e.text}, id); }
+  // Answers one request; an error it throws becomes the request's Error.
   void handle(const proto::Decoded& frame);
+
+  // One handler per message the master serves, `id` the request's; the
+  // template answers every other message with Error UNSUPPORTED.
+  void on(const proto::Hello& m, std::uint32_t id);
+  void on(const proto::SessionOpen& m, std::uint32_t id);
+  void on(const proto::SetLayout& m, std::uint32_t id);
+  void on(const proto::SetScene& m, std::uint32_t id);
+  void on(const proto::StatusRequest& m, std::uint32_t id);
+  void on(const proto::RenderFrame& m, std::uint32_t id);
+  void on(const proto::RenderRotation& m, std::uint32_t id);
+  void on(const proto::PerformanceRequest& m, std::uint32_t id);
+  void on(const proto::Cancel& m, std::uint32_t id);
+  void on(const proto::Close& m, std::uint32_t id);
+  template <class M>
+  void on(const M& m, std::uint32_t id);
+
   void layout(const std::vector<proto::ClusterSpec>& clusters, std::uint32_t id);
-  void setScene(const proto::SetScene& request, std::uint32_t id);
-  void performance(const proto::PerformanceRequest& request, std::uint32_t id);
   // Renders frames 0 .. count - 1, frame k seen by cameraOf(k), in waves of
   // one frame per group; the request's frames go out in order, the last FINAL.
   void renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf, std::uint32_t id);
 
   NodeState& state_;
   PvrdLink& link_;
-  proto::Dispatcher dispatcher_;
   std::deque<proto::Decoded> pending_;  // requests that arrived during a sequence
   SessionScene scene_;
   std::uint32_t framesSent_ = 0;
