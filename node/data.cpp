@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
+#include <nlohmann/json.hpp>
 #include <numeric>
 
 #include "decompose/content.h"
@@ -12,58 +14,21 @@ namespace pvr::node {
 
 namespace {
 
-constexpr core::SplitAxisRule kAxisRule = core::SplitAxisRule::kAlternating;
-
 double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
+// What identifies a volume: equal keys, equal data.
 std::string volumeKeyOf(const core::VolumeSpec& v) {
-  if (!v.file.empty()) return "file:" + v.file;
-  std::string key = "procedural:" + v.procedural;
-  for (int a = 0; a < 3; ++a) key += ":" + std::to_string(v.dims[a]);
-  for (int a = 0; a < 3; ++a) key += ":" + std::to_string(v.spacing ? (*v.spacing)[a] : 0.0);
-  return key;
+  nlohmann::json key = {{"file", v.file}, {"procedural", v.procedural}, {"dims", {v.dims.x, v.dims.y, v.dims.z}}};
+  if (v.spacing) key["spacing"] = {v.spacing->x, v.spacing->y, v.spacing->z};
+  return key.dump();
 }
 
 }  // namespace
 
-RuntimeSettings settingsFrom(const nlohmann::json& j, RuntimeSettings s) {
-  if (!j.is_object()) throw Error(ErrorCode::kInvalidArgument, "runtime: must be an object");
-  for (const auto& [key, value] : j.items()) {
-    if (key == "strategy") {
-      s.strategy = value.get<std::string>();
-    } else if (key == "decomposition") {
-      const auto d = value.get<std::string>();
-      if (d == "kd") s.decomposition = Decomposition::kKd;
-      else if (d == "balanced") s.decomposition = Decomposition::kBalanced;
-      else throw Error(ErrorCode::kInvalidArgument, "runtime.decomposition: kd or balanced, not '" + d + "'");
-    } else if (key == "rebalance_threshold") {
-      s.rebalanceThreshold = value.get<double>();
-      if (!(s.rebalanceThreshold >= 1)) throw Error(ErrorCode::kInvalidArgument, "runtime.rebalance_threshold: >= 1");
-    } else if (key == "pixels") {
-      const auto p = value.get<std::string>();
-      if (p == "rgb8") s.format = proto::PixelFormat::kRgb8;
-      else if (p == "rgba8") s.format = proto::PixelFormat::kRgba8;
-      else throw Error(ErrorCode::kInvalidArgument, "runtime.pixels: rgb8 or rgba8, not '" + p + "'");
-    } else if (key == "compression") {
-      const auto c = value.get<std::string>();
-      if (c == "none") s.compression = proto::Compression::kNone;
-      else if (c == "rle") s.compression = proto::Compression::kRle;
-      else if (c == "zlib") s.compression = proto::Compression::kZlib;
-      else throw Error(ErrorCode::kInvalidArgument, "runtime.compression: none, rle or zlib, not '" + c + "'");
-    } else if (key == "threads") {
-      s.threads = value.get<int>();
-      if (s.threads < 1 || s.threads > 256) throw Error(ErrorCode::kInvalidArgument, "runtime.threads: 1..256");
-    } else {
-      throw Error(ErrorCode::kInvalidArgument, "runtime." + key + ": unknown key");
-    }
-  }
-  return s;
-}
-
-bool openScene(NodeState& state, const nlohmann::json& doc) {
-  core::Scene scene = core::parseScene(doc, state.dataDir);
+bool openScene(NodeState& state, const std::string& sceneJson) {
+  core::Scene scene = core::parseScene(nlohmann::json::parse(sceneJson), state.dataDir);
   const std::string key = volumeKeyOf(scene.volume);
   const bool changed = key != state.volumeKey || !state.source;
   std::unique_ptr<core::VolumeSource> source;
@@ -75,14 +40,12 @@ bool openScene(NodeState& state, const nlohmann::json& doc) {
   core::resolveDefaults(scene, grid->grid());
   const core::RenderOptions options = core::renderOptionsFor(scene);
   const int ghost = core::ghostLayers(grid->grid(), options);
-  composite::makeStrategy(state.settings.strategy);  // a bad name fails here, on every rank
   // Nothing has changed yet: commit.
   if (changed) {
     dropData(state);
     state.source = std::move(source);
     state.volumeKey = key;
   }
-  state.sceneDoc = doc;
   state.scene = scene;
   state.renderOptions = options;
   const bool ghostChanged = ghost != state.ghost;
@@ -94,6 +57,23 @@ void dropData(NodeState& state) {
   state.renderer.reset();
   state.brick = core::Brick();
   state.tree.reset();
+}
+
+void loadBricks(NodeState& state) {
+  std::optional<comm::Failure> failure;
+  try {
+    distributeData(state);
+  } catch (...) {
+    failure = comm::failureOf(std::current_exception(), state.world.rank());
+  }
+  // Max of (-min, max) over the ranks that hold a brick.
+  constexpr double kNone = -std::numeric_limits<double>::infinity();
+  std::vector<double> range{kNone, kNone};
+  if (state.renderer) range = {-state.brick.valueRange().min, state.brick.valueRange().max};
+  state.world.allReduceMax(range);
+  state.valueRange.reset();
+  if (range[1] > kNone) state.valueRange = std::array<double, 2>{-range[0], range[1]};
+  if (failure) throw comm::FailureError(*failure);
 }
 
 void distributeData(NodeState& state) {
@@ -118,7 +98,6 @@ void rebalanceIfNeeded(NodeState& state) {
   if (!state.renders() || !state.tree || state.settings.decomposition != Decomposition::kBalanced) return;
   const auto start = std::chrono::steady_clock::now();
   comm::SubCommunicator& cluster = *state.clusterComm;
-  const int me = state.world.rank();
 
   // What the new transfer function shows in each brick.
   core::ContentGrid content;
@@ -142,7 +121,7 @@ void rebalanceIfNeeded(NodeState& state) {
   // new brick (or takes its share of a scatter).
   std::optional<core::KdTree> tree;
   comm::runAgreed(cluster, [&] {
-    tree = core::KdTree::buildBalanced(state.source->grid(), cluster.size(), kAxisRule, content);
+    tree = core::KdTree::buildBalanced(state.source->grid(), cluster.size(), kSplitAxisRule, content);
   });
   if (state.source->canReadPartially()) {
     state.renderer.reset();

@@ -5,22 +5,25 @@
 // world (ranks outside render clusters return at once where they hold no data).
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include <string>
 
 #include "node.h"
 
 namespace pvr::node {
 
-// The "runtime" object of a SetScene document over `s` (docs/runtime.md);
-// throws pvr::Error (kInvalidArgument) naming a bad key.
-RuntimeSettings settingsFrom(const nlohmann::json& runtime, RuntimeSettings s);
+// Local: parses the scene document `sceneJson` (validated by the master,
+// dataset path resolved) and opens its volume if it differs from the one
+// open; resolves the scene. Changes nothing when it throws. Returns true
+// when the bricks must be read again (new volume, or new ghost layers).
+bool openScene(NodeState& state, const std::string& sceneJson);
 
-// Local: parses `doc` (volume paths already resolved by the master) and
-// opens its volume if it differs from the one open; resolves the scene.
-// Returns true when the volume changed.
-bool openScene(NodeState& state, const nlohmann::json& doc);
+// Collective over the world: render clusters read their bricks (dropping
+// the old ones; distributeData), then every rank learns the data's value
+// range. A rank whose cluster failed to read takes part in the exchange,
+// then throws the cluster's failure.
+void loadBricks(NodeState& state);
 
-// Collective: render clusters read their bricks (dropping the old ones).
+// Collective over each render cluster: its ranks read their bricks.
 void distributeData(NodeState& state);
 
 // Collective: render clusters with a content-balanced decomposition

@@ -1,66 +1,42 @@
 #include "dispatch.h"
 
 #include <chrono>
+#include <cstdio>
 #include <cstring>
+#include <string>
 
 namespace pvr::node {
 
 namespace {
 
-// A command on the wire: i32 action index, then the argument bytes.
-comm::Bytes encodeCommand(int index, const std::string& args) {
-  comm::Bytes out(4 + args.size());
-  const std::int32_t i = index;
-  std::memcpy(out.data(), &i, 4);
-  std::memcpy(out.data() + 4, args.data(), args.size());
-  return out;
-}
-
-std::optional<comm::Failure> runLocal(NodeState& state, int index, const ActionArgs& args) {
+// Runs `action` on this rank, then agrees with every other rank.
+std::optional<comm::Failure> runAgreeing(NodeState& state, const std::function<void()>& action) {
   std::optional<comm::Failure> mine;
   try {
-    actionTable()[std::size_t(index)].run(state, args);
+    action();
   } catch (...) {
     mine = comm::failureOf(std::current_exception(), state.world.rank());
   }
   return state.world.agree(mine);
 }
 
-}  // namespace
-
-void NodeState::matchPoolToSettings() {
-  if (poolThreads == settings.threads) return;
-  pool = std::make_unique<core::ThreadPool>(settings.threads);
-  poolThreads = settings.threads;
-}
-
-void NodeState::maybeFail(const std::string& action) {
-  if (action == failAction && world.rank() == failRank) {
-    failAction.clear();
-    throw Error(ErrorCode::kIo, "injected failure in action " + action);
-  }
-}
-
+// FNV-1a over "index:name;" of every entry.
 std::uint64_t actionTableHash() {
-  // FNV-1a over "index:name;" of every entry.
   std::uint64_t h = 1469598103934665603ull;
   const auto mix = [&](std::string_view s) {
     for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
   };
-  for (std::size_t i = 0; i < actionTable().size(); ++i) {
+  const auto& table = ActionTable::entries();
+  for (std::size_t i = 0; i < table.size(); ++i) {
     mix(std::to_string(i));
     mix(":");
-    mix(actionTable()[i].name);
+    mix(table[i].name);
     mix(";");
   }
   return h;
 }
 
-int actionIndex(std::string_view name) {
-  for (std::size_t i = 0; i < actionTable().size(); ++i)
-    if (actionTable()[i].name == name) return int(i);
-  return -1;
-}
+}  // namespace
 
 void checkActionTables(comm::Communicator& world) {
   const std::uint64_t mine = actionTableHash();
@@ -83,30 +59,33 @@ void checkActionTables(comm::Communicator& world) {
   }
 }
 
-std::optional<comm::Failure> invoke(NodeState& state, std::string_view name, const ActionArgs& args,
-                                  double* broadcastSeconds) {
-  const int index = actionIndex(name);
-  if (index < 0) throw Error(ErrorCode::kInternal, "no action named " + std::string(name));
+std::optional<comm::Failure> postAndRun(NodeState& state, int index, std::span<const std::uint8_t> arguments,
+                                        const std::function<void()>& runHere) {
+  // A command: i32 action index, then the argument bytes.
+  comm::Bytes command(4 + arguments.size());
+  const std::int32_t i = index;
+  std::memcpy(command.data(), &i, 4);
+  std::memcpy(command.data() + 4, arguments.data(), arguments.size());
   const auto start = std::chrono::steady_clock::now();
-  const std::string text = args.is_null() ? std::string() : args.dump();
-  state.commands.post(encodeCommand(index, text));
-  if (broadcastSeconds)
-    *broadcastSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return runLocal(state, index, args);
+  state.commands.post(command);
+  state.commandSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return runAgreeing(state, runHere);
 }
 
 void serveSlave(NodeState& state) {
+  const auto& table = ActionTable::entries();
   while (state.running) {
     const comm::Bytes command = state.commands.await();
     std::int32_t index = -1;
     if (command.size() >= 4) std::memcpy(&index, command.data(), 4);
-    if (index < 0 || std::size_t(index) >= actionTable().size()) {
+    if (index < 0 || std::size_t(index) >= table.size()) {
       // Same table hash on every rank, so this is a broken transport.
       std::fprintf(stderr, "pvr-node: rank %d: command %d out of the action table\n", state.world.rank(), index);
       state.commands.abortJob(1);
     }
-    const std::string text(reinterpret_cast<const char*>(command.data()) + 4, command.size() - 4);
-    runLocal(state, index, text.empty() ? ActionArgs() : ActionArgs::parse(text));
+    const std::span<const std::uint8_t> arguments(reinterpret_cast<const std::uint8_t*>(command.data()) + 4,
+                                                  command.size() - 4);
+    runAgreeing(state, [&] { table[std::size_t(index)].decodeAndRun(state, arguments); });
   }
 }
 

@@ -16,8 +16,6 @@ using core::KdTree;
 namespace {
 
 constexpr int kBrickTag = 20;
-constexpr core::SplitAxisRule kAxisRule = core::SplitAxisRule::kAlternating;
-
 // Reads or receives this rank's brick of `tree`. With a partial reader each
 // rank reads its own; otherwise `whole` (rank 0's copy of the volume) is cut
 // and sent.
@@ -59,6 +57,27 @@ Brick obtainBrick(const core::VolumeSource& source, const KdTree& tree, int ghos
 
 }  // namespace
 
+const std::vector<DecompositionEntry>& decompositions() {
+  static const std::vector<DecompositionEntry> table{{"kd", Decomposition::kKd},
+                                                     {"balanced", Decomposition::kBalanced}};
+  return table;
+}
+
+std::string_view decompositionName(Decomposition d) {
+  for (const DecompositionEntry& e : decompositions())
+    if (e.value == d) return e.name;
+  return "unknown";
+}
+
+Decomposition decompositionNamed(std::string_view name) {
+  std::string known;
+  for (const DecompositionEntry& e : decompositions()) {
+    if (e.name == name) return e.value;
+    known += (known.empty() ? "" : ", ") + std::string(e.name);
+  }
+  throw Error(ErrorCode::kInvalidArgument, "unknown decomposition '" + std::string(name) + "' (known: " + known + ")");
+}
+
 Distribution distributeBricks(const core::VolumeSource& source, const core::Scene& scene,
                               Decomposition decomposition, int ghostLayers, Communicator& comm) {
   Distribution out;
@@ -66,7 +85,7 @@ Distribution distributeBricks(const core::VolumeSource& source, const core::Scen
 
   // The k-d tree: the same on every rank (it depends only on the grid).
   std::optional<KdTree> tree;
-  runAgreed(comm, [&] { tree = KdTree::build(source.grid(), comm.size(), kAxisRule); });
+  runAgreed(comm, [&] { tree = KdTree::build(source.grid(), comm.size(), kSplitAxisRule); });
 
   // Without a partial reader rank 0 holds the whole volume while it scatters.
   std::optional<Brick> whole;
@@ -87,7 +106,7 @@ Distribution distributeBricks(const core::VolumeSource& source, const core::Scen
       content = core::countContent(out.brick, table);
     });
     comm.allReduceSum(content.counts);
-    runAgreed(comm, [&] { tree = KdTree::buildBalanced(source.grid(), comm.size(), kAxisRule, content); });
+    runAgreed(comm, [&] { tree = KdTree::buildBalanced(source.grid(), comm.size(), kSplitAxisRule, content); });
     out.brick = Brick();  // release the first brick before reading the second
     out.brick = obtainBrick(source, *tree, ghostLayers, whole, comm);
   }

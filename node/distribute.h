@@ -11,6 +11,8 @@
 
 #include <cstdint>
 #include <memory>
+#include <string_view>
+#include <vector>
 
 #include "brick.h"
 #include "communicator.h"
@@ -20,10 +22,26 @@
 
 namespace pvr::node {
 
-enum class Decomposition {
+enum class Decomposition : std::uint8_t {
   kKd,        // equal cells per rank
   kBalanced,  // equal non-empty content per rank (decompose/content.h)
 };
+// Action arguments carry a Decomposition (protocol/field_codec.h).
+constexpr bool isWireValue(Decomposition d) { return d <= Decomposition::kBalanced; }
+
+// The one list of decompositions and their names, in the order to list
+// them: runtime settings, pvr-node --batch, status and reports read it.
+struct DecompositionEntry {
+  std::string_view name;
+  Decomposition value;
+};
+const std::vector<DecompositionEntry>& decompositions();
+std::string_view decompositionName(Decomposition d);
+// Throws pvr::Error (kInvalidArgument) naming `name` and the known ones.
+Decomposition decompositionNamed(std::string_view name);
+
+// How every k-d tree of the node picks its split axes.
+constexpr core::SplitAxisRule kSplitAxisRule = core::SplitAxisRule::kAlternating;
 
 struct Distribution {
   core::KdTree tree;

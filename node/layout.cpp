@@ -43,7 +43,6 @@ Layout makeLayout(const std::vector<proto::ClusterSpec>& specsIn, int worldSize)
 
   // The collector entry only says whether rank 0 is dedicated.
   Layout layout;
-  layout.worldSize = worldSize;
   const auto collectors = std::count_if(specs.begin(), specs.end(),
                                         [](const auto& s) { return s.role == proto::ClusterRole::kCollector; });
   if (collectors > 1) bad("at most one collector cluster");

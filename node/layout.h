@@ -39,7 +39,6 @@ struct ClusterPlan {
 
 struct Layout {
   std::vector<ClusterPlan> clusters;
-  int worldSize = 1;
   int groups = 1;
   bool dedicatedMaster = false;  // rank 0 renders and composites nothing
   std::vector<int> clusterOfRank;  // -1: rank 0 when dedicated

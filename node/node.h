@@ -4,6 +4,7 @@
 // also holds the connection's sink for finished frames.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -11,20 +12,20 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "brick.h"
-#include "camera.h"
 #include "command_channel.h"
 #include "communicator.h"
 #include "decompose/kd_tree.h"
 #include "distribute.h"
 #include "image.h"
-#include "image_codec.h"
 #include "io/volume_io.h"
 #include "layout.h"
 #include "pvr_protocol.h"
 #include "raycast/raycaster.h"
+#include "runtime_settings.h"
 #include "scene.h"
 #include "strategy.h"
 #include "sub_communicator.h"
@@ -32,25 +33,12 @@
 
 namespace pvr::node {
 
-// Session settings a client sets through the "runtime" object of a
-// SetScene document (docs/runtime.md); the same on every rank.
-struct RuntimeSettings {
-  std::string strategy = "binary-swap";  // self-compositing clusters
-  Decomposition decomposition = Decomposition::kKd;
-  double rebalanceThreshold = 1.2;  // max/mean content per rank that triggers a rebalance
-  proto::PixelFormat format = proto::PixelFormat::kRgba8;
-  proto::Compression compression = proto::Compression::kZlib;
-  core::ImageCodec codec = core::ImageCodec::kAuto;  // sub-images between ranks
-  int threads = 1;                                   // render threads per rank
-};
-
 // One frame of the wave in flight, as this rank sees it.
 struct WaveFrame {
-  int frame = 0;  // position in the request
+  std::uint32_t number = 0;  // position in the request
   core::CameraSpec camera;
   core::Image partial;  // render ranks: this rank's brick, cut to its band
-  bool mine = false;    // this rank renders or composites it
-  double rend = 0, comp = 0, comm = 0;
+  double rend = 0, comp = 0, comm = 0;  // this rank's seconds on the frame
 };
 
 // Compositing measured per cluster, for "performance comp".
@@ -65,7 +53,6 @@ struct Calibration {
   double latency = 0;        // seconds per message, one way
   double bandwidth = 0;      // bytes per second
   double blendRate = 0;      // pixels "over" per second
-  bool measured = false;
 };
 
 struct NodeState {
@@ -86,7 +73,6 @@ struct NodeState {
 
   // Scene and data.
   RuntimeSettings settings;
-  nlohmann::json sceneDoc = nlohmann::json::object();  // without "runtime"
   std::string volumeKey;  // what the source was opened from
   std::unique_ptr<core::VolumeSource> source;
   core::Scene scene;  // resolved for source's grid
@@ -98,12 +84,14 @@ struct NodeState {
   double pendingDist = 0;  // (re)distribution time not yet charged to a frame
   int rebalances = 0;
   double imbalance = 0;  // max/mean content per rank at the last transfer-function change (master's cluster)
+  // The data's finite values, min and max over every brick; set by every
+  // (re)distribution (loadBricks), on every rank.
+  std::optional<std::array<double, 2>> valueRange;
 
   // The wave in flight.
   std::vector<WaveFrame> wave;
   // Collector: finished bands of the wave, by (wave slot, band).
   std::map<std::pair<int, int>, core::Image> bands;
-  std::optional<comm::Failure> bandFailure;  // the first failure a band brought
 
   Calibration calibration;
   CompositeLog compositeLog;
@@ -112,31 +100,19 @@ struct NodeState {
   // Resizes the pool to settings.threads when that changed.
   void matchPoolToSettings();
 
-  // Tests: make `failAction` throw once on world rank `failRank`.
-  std::string failAction;
-  int failRank = -1;
-  void maybeFail(const std::string& action);
+  // Tests: each step of `injectedFailures` throws once, on its world rank
+  // (--fail-once STEP@RANK; the steps are "render" and "composite").
+  std::vector<std::pair<std::string, int>> injectedFailures;
+  void maybeFail(const std::string& step);
 
   // Master only: what the last action answered (memory, latency reports).
   nlohmann::json reply;
+  // Master only: seconds the last command took to reach the other ranks.
+  double commandSeconds = 0;
   // Master only: where the collector's finished frames go, and a float
   // copy for exact comparison when dumpDir is set.
   std::function<void(proto::ImageFrame&&, bool final)> sendFrame;
   std::string dumpDir;
 };
-
-using ActionArgs = nlohmann::json;
-using ActionFn = void (*)(NodeState&, const ActionArgs&);
-
-struct ActionEntry {
-  std::string_view name;
-  ActionFn run;
-};
-
-// The action table (actions/table.cpp): every rank runs what the master
-// names; the table's hash is compared at start.
-const std::vector<ActionEntry>& actionTable();
-std::uint64_t actionTableHash();
-int actionIndex(std::string_view name);  // -1 if unknown
 
 }  // namespace pvr::node

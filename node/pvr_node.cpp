@@ -6,11 +6,11 @@
 // Batch mode renders one scene across the ranks and writes the frame:
 //
 //   mpirun -np N pvr-node --batch SCENE.json -o OUT.exr|OUT.png
-//          [--strategy binary-swap|direct-send|tree|radix-k] [--radix K]
-//          [--decomposition kd|balanced] [--early-termination A]
-//          [--threads N] [--codec auto|rle|rle-zlib|raw] [--size WxH]
-//          [--stats FILE.csv]
+//          [--strategy NAME] [--radix K] [--decomposition NAME]
+//          [--early-termination A] [--threads N] [--codec auto|rle|rle-zlib|raw]
+//          [--size WxH] [--stats FILE.csv]
 //
+// (the usage text lists the registered strategies and decompositions).
 // Every rank reads its own brick (or rank 0 scatters when the format cannot
 // read part of a file), renders it, and the ranks composite; rank 0 writes
 // the image and prints the time breakdown. Any rank's failure makes every
@@ -34,11 +34,21 @@ struct Args {
   node::FrameOptions frame;
 };
 
-constexpr const char* kUsage =
-    "usage: mpirun -np N pvr-node --server --connect HOST:PORT --data-dir DIR\n"
-    "       mpirun -np N pvr-node --batch SCENE.json -o OUT.exr|OUT.png [--strategy NAME] [--radix K]\n"
-    "       [--decomposition kd|balanced] [--early-termination A] [--threads N]\n"
-    "       [--codec auto|rle|rle-zlib|raw] [--size WxH] [--stats FILE.csv]\n";
+// Names joined by `separator`, from a registration table.
+template <class Table>
+std::string names(const Table& table, const char* separator) {
+  std::string out;
+  for (const auto& entry : table) out += (out.empty() ? "" : separator) + std::string(entry.name);
+  return out;
+}
+
+std::string usage() {
+  return "usage: mpirun -np N pvr-node --server --connect HOST:PORT --data-dir DIR\n"
+         "       mpirun -np N pvr-node --batch SCENE.json -o OUT.exr|OUT.png\n"
+         "       [--strategy " + names(composite::strategies(), "|") + "] [--radix K]\n"
+         "       [--decomposition " + names(node::decompositions(), "|") + "] [--early-termination A]\n"
+         "       [--threads N] [--codec auto|rle|rle-zlib|raw] [--size WxH] [--stats FILE.csv]\n";
+}
 
 [[noreturn]] void bad(const std::string& why) { throw Error(ErrorCode::kInvalidArgument, why); }
 
@@ -83,9 +93,11 @@ Args parseArgs(int argc, char** argv) {
       a.frame.strategyParams.radix = integer(arg, value());
     } else if (arg == "--decomposition") {
       const std::string v = value();
-      if (v == "kd") a.frame.decomposition = node::Decomposition::kKd;
-      else if (v == "balanced") a.frame.decomposition = node::Decomposition::kBalanced;
-      else bad("--decomposition takes kd or balanced, not '" + v + "'");
+      try {
+        a.frame.decomposition = node::decompositionNamed(v);
+      } catch (const Error& e) {
+        bad("--decomposition: " + std::string(e.what()));
+      }
     } else if (arg == "--early-termination") {
       const std::string v = value();
       try {
@@ -148,7 +160,7 @@ int main(int argc, char** argv) {
   } catch (const Error& e) {
     if (comm.rank() == 0) {
       std::fprintf(stderr, "pvr-node: %s\n", e.what());
-      if (e.code() == ErrorCode::kInvalidArgument) std::fputs(kUsage, stderr);
+      if (e.code() == ErrorCode::kInvalidArgument) std::fputs(usage().c_str(), stderr);
     }
     return e.code() == ErrorCode::kInvalidArgument ? 2 : 1;
   }

@@ -30,8 +30,6 @@ std::string line(const char* format, auto... args) {
   return buffer;
 }
 
-const char* decompositionName(Decomposition d) { return d == Decomposition::kKd ? "kd" : "balanced"; }
-
 }  // namespace
 
 TrafficTotals sumTraffic(const std::vector<RankReport>& ranks) {
@@ -52,7 +50,7 @@ std::string formatReport(const FrameResult& result, const FrameOptions& options)
   const int n = int(ranks.size());
   std::string out;
   out += line("%s, %d ranks, %s, %s decomposition, %dx%d\n", result.volume.c_str(), n,
-              options.strategy.c_str(), decompositionName(options.decomposition),
+              options.strategy.c_str(), std::string(decompositionName(options.decomposition)).c_str(),
               result.scene.image.width, result.scene.image.height);
   out += "time (s)    max       mean      min\n";
   for (const Column& c : timeColumns()) {

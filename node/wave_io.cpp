@@ -1,31 +1,26 @@
 #include "wave_io.h"
 
 #include <algorithm>
-#include <cstring>
 
 namespace pvr::node {
 
-nlohmann::json cameraToJson(const core::CameraSpec& c) {
-  return {{"perspective", c.projection == core::Projection::kPerspective},
-          {"eye", {c.eye.x, c.eye.y, c.eye.z}},
-          {"look_at", {c.lookAt.x, c.lookAt.y, c.lookAt.z}},
-          {"up", {c.up.x, c.up.y, c.up.z}},
-          {"height", c.height},
-          {"fov_y_deg", c.fovYDeg}};
+CameraArgs cameraArgs(const core::CameraSpec& c) {
+  return {c.projection == core::Projection::kPerspective,
+          {c.eye.x, c.eye.y, c.eye.z},
+          {c.lookAt.x, c.lookAt.y, c.lookAt.z},
+          {c.up.x, c.up.y, c.up.z},
+          c.height,
+          c.fovYDeg};
 }
 
-core::CameraSpec cameraFromJson(const nlohmann::json& j) {
+core::CameraSpec cameraSpec(const CameraArgs& a) {
   core::CameraSpec c;
-  const auto vec = [&](const char* key) {
-    const auto& a = j.at(key);
-    return core::Vec3{a.at(0).get<double>(), a.at(1).get<double>(), a.at(2).get<double>()};
-  };
-  c.projection = j.at("perspective").get<bool>() ? core::Projection::kPerspective : core::Projection::kOrthographic;
-  c.eye = vec("eye");
-  c.lookAt = vec("look_at");
-  c.up = vec("up");
-  c.height = j.at("height").get<double>();
-  c.fovYDeg = j.at("fov_y_deg").get<double>();
+  c.projection = a.perspective ? core::Projection::kPerspective : core::Projection::kOrthographic;
+  c.eye = {a.eye[0], a.eye[1], a.eye[2]};
+  c.lookAt = {a.lookAt[0], a.lookAt[1], a.lookAt[2]};
+  c.up = {a.up[0], a.up[1], a.up[2]};
+  c.height = a.height;
+  c.fovYDeg = a.fovYDeg;
   c.automatic = false;
   return c;
 }
@@ -57,11 +52,10 @@ void paste(core::Image& frame, const core::Image& part) {
   for (int y = r.y0; y < r.y1; ++y) std::copy(&part.at(r.x0, y), &part.at(r.x0, y) + r.width(), &frame.at(r.x0, y));
 }
 
-void sendSubImage(comm::Communicator& comm, int to, int tag, const SubImage& message, core::ImageCodec codec,
-                  std::uint64_t* bytesSent) {
+void sendSubImage(comm::Communicator& comm, int to, int tag, const SubImage& message, std::uint64_t* bytesSent) {
   comm::Bytes bytes = comm::encodeFailure(message.failure);
   if (!message.failure) {
-    const core::EncodedImage encoded = core::encodeImage(message.image, codec);
+    const core::EncodedImage encoded = core::encodeImage(message.image, kSubImageCodec);
     bytes.insert(bytes.end(), encoded.bytes.begin(), encoded.bytes.end());
   }
   if (bytesSent) *bytesSent += bytes.size();

@@ -5,8 +5,7 @@
 // slowest counts). Every rank ends with the same Calibration.
 #include <chrono>
 
-#include "../node.h"
-#include "../wave_io.h"
+#include "table.h"
 
 namespace pvr::node::actions {
 
@@ -31,7 +30,7 @@ double pingPong(comm::Communicator& world, int peer, std::size_t bytes, int roun
 
 }  // namespace
 
-void calibrate(NodeState& state, const ActionArgs&) {
+void Calibrate::run(NodeState& state, const Calibrate&) {
   comm::Communicator& world = state.world;
   const int peer = world.size() - 1;
   std::vector<double> measured(3, 0.0);  // latency, seconds per byte, seconds per pixel
@@ -56,7 +55,6 @@ void calibrate(NodeState& state, const ActionArgs&) {
   state.calibration.latency = measured[0];
   state.calibration.bandwidth = measured[1] > 0 ? 1.0 / measured[1] : 0.0;
   state.calibration.blendRate = measured[2] > 0 ? 1.0 / measured[2] : 0.0;
-  state.calibration.measured = true;
 }
 
 }  // namespace pvr::node::actions

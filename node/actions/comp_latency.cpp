@@ -1,6 +1,6 @@
-// comp_latency {"cluster": index or -1}: per compositing cluster (render
-// clusters that composite themselves, and composite clusters), the latency
-// model's estimate beside the measured mean compositing time per frame.
+// comp_latency: per compositing cluster (render clusters that composite
+// themselves, and composite clusters), the latency model's estimate beside
+// the measured mean compositing time per frame, into state.reply.
 //
 // Model, calibrated by the calibrate action: a rank's compositing time is
 // messages * latency + bytes / bandwidth + pixels / blend rate, over the
@@ -8,11 +8,11 @@
 // composite-cluster rank received, and pixels blended); the cluster takes
 // as long as its slowest rank. Measured: the slowest rank's mean of
 // compositing compute plus communication time per frame.
-#include "../node.h"
+#include "table.h"
 
 namespace pvr::node::actions {
 
-void compLatency(NodeState& state, const ActionArgs& args) {
+void CompLatency::run(NodeState& state, const CompLatency& args) {
   const auto& log = state.compositeLog;
   const auto& cal = state.calibration;
   const double model = double(log.last.messagesSent + log.last.gatherMessagesSent) * cal.latency +
@@ -27,7 +27,7 @@ void compLatency(NodeState& state, const ActionArgs& args) {
   state.world.allReduceMax(values);  // each rank fills only its own slots
   if (state.world.rank() != 0) return;
 
-  const int only = args.value("cluster", -1);
+  const int only = args.cluster;
   nlohmann::json clusters = nlohmann::json::array();
   for (std::size_t c = 0; c < state.layout.clusters.size(); ++c) {
     const ClusterPlan& plan = state.layout.clusters[c];

@@ -1,17 +1,17 @@
-// report_memory {"cluster": index or -1}: dataset bytes each rank holds
-// (its brick: owned nodes plus ghost layers), per cluster. The master
-// keeps the answer in state.reply for "performance memory cluster".
-#include "../node.h"
+// report_memory: dataset bytes each rank holds (its brick: owned nodes plus
+// ghost layers), per cluster. The master keeps the answer in state.reply
+// for "performance memory cluster".
+#include "table.h"
 
 namespace pvr::node::actions {
 
-void reportMemory(NodeState& state, const ActionArgs& args) {
+void ReportMemory::run(NodeState& state, const ReportMemory& args) {
   std::vector<std::uint64_t> bytes(std::size_t(state.world.size()), 0);
   // Ranks without a brick (composite clusters, a dedicated collector) hold none.
   bytes[std::size_t(state.world.rank())] = state.renderer ? state.brick.byteSize() : 0;
   state.world.allReduceSum(bytes);
   if (state.world.rank() != 0) return;
-  const int only = args.value("cluster", -1);
+  const int only = args.cluster;
   nlohmann::json clusters = nlohmann::json::array();
   for (std::size_t c = 0; c < state.layout.clusters.size(); ++c) {
     if (only >= 0 && std::size_t(only) != c) continue;

@@ -1,21 +1,21 @@
-// set_scene {"scene": document, "runtime": settings}: new transfer function,
-// camera, image size, sampling or runtime settings (docs/runtime.md). Opens
-// and distributes the volume if it changed (as load_dataset), re-reads
-// bricks when the ghost layers or the decomposition change, and rebalances
-// a content-balanced decomposition that the new transfer function leaves
-// uneven (data.h).
+// set_scene: a new scene document and runtime settings (docs/runtime.md),
+// validated by the master already. Every rank parses the document once and
+// opens the volume if it changed (headers only); the render clusters read
+// their bricks again when the volume, the ghost layers or the decomposition
+// changed, else re-classify them and rebalance a content-balanced
+// decomposition that the new transfer function leaves uneven (data.h).
 #include "../data.h"
-#include "../node.h"
+#include "table.h"
 
 namespace pvr::node::actions {
 
-void setScene(NodeState& state, const ActionArgs& args) {
+void SetScene::run(NodeState& state, const SetScene& args) {
   bool redistribute = false;
   comm::runAgreed(state.world, [&] {
     const RuntimeSettings old = state.settings;
-    state.settings = settingsFrom(args.value("runtime", nlohmann::json::object()), old);
+    state.settings = args.settings;
     try {
-      redistribute = openScene(state, args.at("scene")) || state.settings.decomposition != old.decomposition;
+      redistribute = openScene(state, args.sceneJson) || state.settings.decomposition != old.decomposition;
     } catch (...) {
       state.settings = old;
       throw;
@@ -23,7 +23,7 @@ void setScene(NodeState& state, const ActionArgs& args) {
     state.matchPoolToSettings();
     classify(state);
   });
-  if (redistribute) distributeData(state);
+  if (redistribute) loadBricks(state);
   else rebalanceIfNeeded(state);
 }
 

@@ -1,8 +1,8 @@
 // shutdown: every rank leaves its loop; the job ends with MPI_Finalize.
-#include "../node.h"
+#include "table.h"
 
 namespace pvr::node::actions {
 
-void shutdown(NodeState& state, const ActionArgs&) { state.running = false; }
+void Shutdown::run(NodeState& state, const Shutdown&) { state.running = false; }
 
 }  // namespace pvr::node::actions

@@ -165,16 +165,16 @@ int matrix(comm::Communicator& comm, const fs::path& dir) {
     Image reference;
     if (comm.rank() == 0) reference = renderSerial(scene);
     for (const StrategyCase& c : cases)
-      for (auto decomposition : {node::Decomposition::kKd, node::Decomposition::kBalanced}) {
+      for (const auto& [decompositionLabel, decomposition] : node::decompositions()) {
         node::FrameOptions options;
         options.strategy = c.name;
         options.strategyParams.radix = c.radix;
         options.decomposition = decomposition;
         const node::FrameResult result = node::renderFrame(scene, options, comm);
         ++frames;
-        const std::string label = c.name + (c.name == "radix-k" ? " k=" + std::to_string(c.radix) : "") +
-                                  (decomposition == node::Decomposition::kKd ? ", kd, " : ", balanced, ") +
-                                  view.name + ", " + std::to_string(n) + " ranks";
+        const std::string label = c.name + (c.name == "radix-k" ? " k=" + std::to_string(c.radix) : "") + ", " +
+                                  std::string(decompositionLabel) + ", " + view.name + ", " + std::to_string(n) +
+                                  " ranks";
         if (comm.rank() == 0) {
           const double diff = maxAbsDifference(result.image, reference);
           check(comm, diff <= kTolerance, label + ": max abs difference " + std::to_string(diff));
@@ -188,10 +188,10 @@ int matrix(comm::Communicator& comm, const fs::path& dir) {
   }
 
   // The scatter path (gzip: rank 0 reads and sends bricks) renders alike.
-  for (auto decomposition : {node::Decomposition::kKd, node::Decomposition::kBalanced}) {
+  for (const auto& entry : node::decompositions()) {
     const Scene scene = sceneFor(gzipFile, views(grid)[2].camera, false);
     node::FrameOptions options;
-    options.decomposition = decomposition;
+    options.decomposition = entry.value;
     const node::FrameResult result = node::renderFrame(scene, options, comm);
     ++frames;
     check(comm, !result.readPartially, "gzip volume: expected rank 0 to scatter");

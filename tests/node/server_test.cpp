@@ -2,7 +2,8 @@
 // handler would: listen on loopback, start the job, speak the protocol.
 // Every frame must equal an in-process BrickRenderer rendering of the same
 // view within 1e-5 (the job writes its float frames with --dump-frames),
-// in order, for each layout of the session.
+// in order, for each layout of the session; failures injected on one rank
+// (--fail-once STEP@RANK) reach the client and leave the session serving.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -17,6 +18,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -26,6 +29,7 @@
 #include "pvr_protocol.h"
 #include "raycast/raycaster.h"
 #include "scene.h"
+#include "strategy.h"
 #include "thread_pool.h"
 
 namespace {
@@ -150,6 +154,11 @@ class Job {
     REQUIRE(std::holds_alternative<proto::ErrorMessage>(d->message));
     return std::get<proto::ErrorMessage>(d->message);
   }
+  // Closes the session; true if the job then ended by itself within 30 s.
+  bool close() {
+    send(proto::Close{"done"});
+    return reap(30);
+  }
   // Waits for mpirun to exit; true if it did within `seconds`.
   bool reap(int seconds) {
     const auto until = Clock::now() + std::chrono::seconds(seconds);
@@ -185,8 +194,11 @@ class Reference {
     options_ = core::renderOptionsFor(scene_);
     renderer_->classify(scene_.transfer, options_);
   }
-  // Frame k of RenderRotation{axis (0,1,0) or given, 0.., steps}: the
-  // master's formula (server_mode.cpp).
+  const core::Scene& scene() const { return scene_; }
+  const core::ValueRange& valueRange() const { return brick_.valueRange(); }
+  // Frame k of RenderRotation{axis (0,1,0) or given, 0.., steps}: eye and
+  // up turned about look_at (docs/protocol.md), written out here apart
+  // from the node's rotation.cpp.
   core::Image frame(int k, int steps, core::Vec3 axis = {0, 1, 0}) const {
     core::CameraSpec c = scene_.camera;
     const double angle = 2 * M_PI * double(k) / double(steps);
@@ -243,6 +255,22 @@ void checkSequence(Job& job, std::uint32_t request, int frames, int steps, const
   }
 }
 
+// "list status" as a map.
+std::map<std::string, std::string> statusOf(Job& job) {
+  job.send(proto::StatusRequest{});
+  std::map<std::string, std::string> out;
+  for (const auto& kv : job.expect<proto::StatusReply>().entries) out[kv.key] = kv.value;
+  return out;
+}
+
+// The numbers of a Tcl list of numbers.
+std::vector<double> numbers(const std::string& list) {
+  std::istringstream in(list);
+  std::vector<double> out;
+  for (std::string word; in >> word;) out.push_back(std::stod(word));
+  return out;
+}
+
 struct Fixture {
   Fixture() {
     static bool written = false;
@@ -268,7 +296,7 @@ TEST_CASE_METHOD(Fixture, "clusters, groups and a compositing cluster all render
   // the next render works.
   job.send(proto::RenderFrame{});
   const auto e = job.expectError();
-  CHECK(e.text.find("rank 2: injected failure in action render") != std::string::npos);
+  CHECK(e.text.find("rank 2: injected failure in render") != std::string::npos);
 
   SECTION("one cluster compositing itself; memory and latency reports") {
     const auto id = job.send(proto::RenderFrame{});
@@ -337,8 +365,95 @@ TEST_CASE_METHOD(Fixture, "clusters, groups and a compositing cluster all render
     const Reference narrowRef(nlohmann::json::parse(narrow));
     CHECK(core::maxAbsDifference(dumped(job, id, 0), narrowRef.frame(0, 1)) <= 1e-5);
   }
-  job.send(proto::Close{"done"});
-  CHECK(job.reap(30));
+  CHECK(job.close());
+}
+
+TEST_CASE_METHOD(Fixture, "a failure on a rank that sends to a compositing cluster, or on a compositing rank, reaches the client") {
+  Job job(4, {"--fail-once", "render@1", "--fail-once", "composite@2"});
+  job.send(proto::SessionOpen{4, {{ClusterRole::kRender, 3, 0}, {ClusterRole::kComposite, 1, 0}}});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  const Reference ref(nlohmann::json::object());
+  // Ranks 0-2 render and send their sub-images to rank 3, which sends the
+  // band to the collector: rank 1's failure travels with its sub-image.
+  job.send(proto::RenderFrame{});
+  CHECK_THAT(job.expectError().text, Catch::Contains("rank 1: injected failure in render"));
+  // Ranks 2 and 3 composite: rank 2 fails, still takes its run and rank
+  // 3's image, and sends the failure as the band.
+  job.send(proto::SetLayout{{{ClusterRole::kRender, 2, 0}, {ClusterRole::kComposite, 2, 0}}});
+  job.expect<proto::SessionReady>();
+  job.send(proto::RenderFrame{});
+  CHECK_THAT(job.expectError().text, Catch::Contains("rank 2: injected failure in composite"));
+  const auto id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 2, 12});
+  checkSequence(job, id, 3, 12, ref);
+  CHECK(job.close());
+}
+
+TEST_CASE_METHOD(Fixture, "scene patches are checked whole before and after the dataset, and status reports the session") {
+  Job job(2, {});
+  job.send(proto::SessionOpen{2, {}});
+  job.expect<proto::SessionReady>();
+
+  // Before any dataset: the lists a client offers and the settings.
+  auto status = statusOf(job);
+  std::string strategies;
+  for (const auto& entry : composite::strategies()) {
+    if (!strategies.empty()) strategies += ' ';
+    strategies += entry.name;
+  }
+  CHECK(status["strategies"] == strategies);
+  CHECK(status["decompositions"] == "kd balanced");
+  CHECK(status["strategy"] == "binary-swap");
+  CHECK(status["decomposition"] == "kd");
+  for (const char* key : {"camera_eye", "image_size", "bounds", "value_range", "transfer_function"})
+    CHECK(status.count(key) == 0);
+
+  // A misspelt key, an unknown strategy, an image too big for a frame: each
+  // refused with what was wrong, none kept for the dataset load that follows.
+  job.send(proto::SetScene{"", R"({"shading": {"enabeld": true}})"});
+  auto e = job.expectError();
+  CHECK(e.code == proto::ErrorCode::kBadArgument);
+  CHECK_THAT(e.text, Catch::Contains("shading.enabeld"));
+  job.send(proto::SetScene{"", R"({"runtime": {"strategy": "swap-binary"}})"});
+  CHECK_THAT(job.expectError().text, Catch::Contains("runtime.strategy") && Catch::Contains("direct-send"));
+  const char* huge = R"({"image": {"width": 16384, "height": 16384}})";
+  job.send(proto::SetScene{"", huge});
+  e = job.expectError();
+  CHECK(e.code == proto::ErrorCode::kLimitExceeded);
+  CHECK_THAT(e.text, Catch::Contains(std::to_string(proto::Limits{}.maxImagePixels)));
+  job.send(proto::SetScene{"", R"({"runtime": {"decomposition": "balanced"}})"});
+  job.expect<proto::Ok>();
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  const Reference ref(nlohmann::json::object());
+  auto id = job.send(proto::RenderFrame{});
+  checkSequence(job, id, 1, 1, ref);
+
+  // With the dataset open: refused alike, and the next frame is as before.
+  job.send(proto::SetScene{"", huge});
+  CHECK(job.expectError().code == proto::ErrorCode::kLimitExceeded);
+  id = job.send(proto::RenderFrame{});
+  checkSequence(job, id, 1, 1, ref);
+
+  // The camera in use (the resolved automatic one), image, domain, data
+  // range and transfer function, at full precision.
+  status = statusOf(job);
+  const core::Scene& scene = ref.scene();
+  CHECK(status["decomposition"] == "balanced");
+  CHECK(status["camera_projection"] == "perspective");
+  CHECK(numbers(status["camera_eye"]) == std::vector{scene.camera.eye.x, scene.camera.eye.y, scene.camera.eye.z});
+  CHECK(numbers(status["camera_look_at"]) == std::vector{scene.camera.lookAt.x, scene.camera.lookAt.y, scene.camera.lookAt.z});
+  CHECK(numbers(status["camera_up"]) == std::vector{scene.camera.up.x, scene.camera.up.y, scene.camera.up.z});
+  CHECK(numbers(status["camera_fov_y_deg"]) == std::vector{scene.camera.fovYDeg});
+  CHECK(status["image_size"] == "64 64");
+  CHECK(numbers(status["bounds"]) == std::vector<double>{0, 0, 0, kDims[0] - 1, kDims[1] - 1, (kDims[2] - 1) * 1.25});
+  CHECK(numbers(status["value_range"]) == std::vector{ref.valueRange().min, ref.valueRange().max});
+  std::vector<double> points;
+  for (const auto& p : scene.transfer.points) points.insert(points.end(), {p.scalar, p.r, p.g, p.b, p.opacity});
+  CHECK(points.size() == 20);
+  CHECK(numbers(status["transfer_function"]) == points);
+  CHECK(job.close());
 }
 
 TEST_CASE_METHOD(Fixture, "a rank killed mid-sequence: the handler side sees the end and nothing is left running") {

@@ -1,28 +1,14 @@
-// composite: the sub-images of the wave rendered by `render` become one
-// band per render cluster at the collector (world rank 0).
-//
-//   - a render cluster without a composite cluster composites itself with
-//     the session's strategy (binary-swap by default) on its cluster
-//     communicator; its rank 0 sends the band to the collector;
-//   - a render cluster served by a composite cluster of m ranks: its rank 0
-//     sends the frame's visibility order to the composite ranks; render
-//     rank at position p of that order sends its sub-image to composite
-//     rank floor(p*m/n) (contiguous runs of the order); each composite rank
-//     blends its run front to back as the images arrive, then the
-//     composite ranks reduce in a binary tree (rank j takes j + stride,
-//     front over back, since runs are in order); their rank 0 sends the band.
-//   - the collector receives every band of every frame of the wave, in
-//     frame and band order.
-// Every rank that someone waits for always sends: an image or the failure
-// that stopped it, so a failure anywhere reaches the collector and nobody
-// deadlocks; the dispatcher's agreement then reports it.
+#include "wave_composite.h"
+
 #include <chrono>
 #include <cstring>
+#include <numeric>
+#include <span>
+#include <vector>
 
-#include "../node.h"
-#include "../wave_io.h"
+#include "wave_io.h"
 
-namespace pvr::node::actions {
+namespace pvr::node {
 
 namespace {
 
@@ -30,15 +16,20 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+void keepFirst(std::optional<comm::Failure>& first, const std::optional<comm::Failure>& next) {
+  if (next && !first) first = next;
+}
+
 // A finished band: kept if this is the collector, else sent to it.
-void deliver(NodeState& state, int slot, int band, const SubImage& message, double& comm) {
+void deliver(NodeState& state, int slot, int band, const SubImage& message, double& comm,
+             std::optional<comm::Failure>& failure) {
   if (state.world.rank() == 0) {
-    if (message.failure && !state.bandFailure) state.bandFailure = message.failure;
+    keepFirst(failure, message.failure);
     if (!message.failure) state.bands[{slot, band}] = message.image;
     return;
   }
   const auto t = Clock::now();
-  sendSubImage(state.world, 0, kBandTag, message, state.settings.codec);
+  sendSubImage(state.world, 0, kBandTag, message);
   comm += secondsSince(t);
 }
 
@@ -49,21 +40,24 @@ int runOf(int position, int n, int m) {
   return j;
 }
 
-void compositeSelf(NodeState& state, int slot, WaveFrame& w) {
+void compositeSelf(NodeState& state, int slot, WaveFrame& w, std::optional<comm::Failure>& failure) {
   const ClusterPlan& me = *state.myCluster();
   comm::SubCommunicator& cluster = *state.clusterComm;
   const int width = state.scene.image.width, height = state.scene.image.height;
-  std::optional<comm::Failure> failure;
   composite::CompositeResult result;
-  try {
-    const core::Camera camera(w.camera, width, height);
-    const auto strategy = composite::makeStrategy(state.settings.strategy);
-    composite::CompositeOptions options;
-    options.codec = state.settings.codec;
-    // Strategies want full-frame partials; the band crop keeps them sparse.
-    result = strategy->composite(w.partial, *state.tree, camera, cluster, options);
-  } catch (...) {
-    failure = comm::failureOf(std::current_exception(), state.world.rank());
+  // Without a tree (the cluster's bricks could not be read) every rank of
+  // the cluster failed its render alike: there is nothing to composite.
+  if (state.tree) {
+    try {
+      const core::Camera camera(w.camera, width, height);
+      const auto strategy = composite::makeStrategy(state.settings.strategy);
+      composite::CompositeOptions options;
+      options.codec = kSubImageCodec;
+      // Strategies want full-frame partials; the band crop keeps them sparse.
+      result = strategy->composite(w.partial, *state.tree, camera, cluster, options);
+    } catch (...) {
+      keepFirst(failure, comm::failureOf(std::current_exception(), state.world.rank()));
+    }
   }
   failure = cluster.agree(failure);
   w.comp += result.stats.computeSeconds;
@@ -74,19 +68,27 @@ void compositeSelf(NodeState& state, int slot, WaveFrame& w) {
   if (cluster.rank() != 0) return;
   SubImage band{failure, {}};
   if (!failure) band.image = cropToRect(result.image, bandRect(width, height, me.band, me.bands));
-  deliver(state, slot, me.band, band, w.comm);
+  deliver(state, slot, me.band, band, w.comm, failure);
 }
 
-void sendToCompositors(NodeState& state, WaveFrame& w) {
+void sendToCompositors(NodeState& state, WaveFrame& w, std::optional<comm::Failure>& failure) {
   const ClusterPlan& me = *state.myCluster();
   const ClusterPlan& comp = state.layout.clusters[std::size_t(me.compositor)];
   comm::SubCommunicator& cluster = *state.clusterComm;
   const int n = cluster.size(), m = int(comp.ranks.size());
   const auto t = Clock::now();
-  // The order is a pure function of the tree and camera: no failure here
-  // that the other ranks would not share.
-  const core::Camera camera(w.camera, state.scene.image.width, state.scene.image.height);
-  const std::vector<int> order = state.tree->visibilityOrder(camera);
+  // The order is a pure function of the tree and camera, the same on every
+  // rank of the cluster; without a tree (the cluster's bricks could not be
+  // read, on all its ranks alike) the identity order keeps the sends matched.
+  std::vector<int> order(static_cast<std::size_t>(n));
+  std::iota(order.begin(), order.end(), 0);
+  if (state.tree) {
+    try {
+      order = state.tree->visibilityOrder(core::Camera(w.camera, state.scene.image.width, state.scene.image.height));
+    } catch (...) {
+      keepFirst(failure, comm::failureOf(std::current_exception(), state.world.rank()));
+    }
+  }
   if (cluster.rank() == 0) {
     std::vector<std::int32_t> wire(order.begin(), order.end());
     const auto bytes = std::as_bytes(std::span(wire));
@@ -95,15 +97,15 @@ void sendToCompositors(NodeState& state, WaveFrame& w) {
   int position = 0;
   while (order[std::size_t(position)] != cluster.rank()) ++position;
   std::uint64_t sent = 0;
-  sendSubImage(state.world, comp.ranks[std::size_t(runOf(position, n, m))], kPartialTag, {std::nullopt, w.partial},
-               state.settings.codec, &sent);
+  sendSubImage(state.world, comp.ranks[std::size_t(runOf(position, n, m))], kPartialTag,
+               {failure, failure ? core::Image() : w.partial}, &sent);
   w.comm += secondsSince(t);
   state.compositeLog.last = {};
   state.compositeLog.last.messagesSent = 1;
   state.compositeLog.last.encodedBytesSent = sent;
 }
 
-void compositeServed(NodeState& state) {
+void compositeServed(NodeState& state, std::optional<comm::Failure>& rankFailure) {
   const ClusterPlan& me = *state.myCluster();
   comm::SubCommunicator& comp = *state.clusterComm;
   const int j = comp.rank(), m = comp.size();
@@ -113,9 +115,15 @@ void compositeServed(NodeState& state) {
     if (render.group >= int(state.wave.size())) continue;
     const int slot = render.group;
     WaveFrame& w = state.wave[std::size_t(slot)];
-    w.mine = true;
     const int n = int(render.ranks.size());
+    // The band's failure: a sub-image's, or this rank's own; a failed rank
+    // still receives its run, so no render rank waits on its send.
     std::optional<comm::Failure> failure;
+    try {
+      state.maybeFail("composite");
+    } catch (...) {
+      failure = comm::failureOf(std::current_exception(), state.world.rank());
+    }
     core::Image acc(width, height, core::PixelRect{});
     // Traffic this rank received and blended: the work on its critical path.
     composite::CompositeStats stats;
@@ -127,7 +135,7 @@ void compositeServed(NodeState& state) {
       stats.messagesSent += 1;
       stats.pixelsSent += std::uint64_t(in.image.rect().width()) * std::uint64_t(in.image.rect().height());
       start = Clock::now();
-      if (in.failure && !failure) failure = in.failure;
+      keepFirst(failure, in.failure);
       if (!failure) blendOver(acc, in.image);
       w.comp += secondsSince(start);
     };
@@ -149,7 +157,7 @@ void compositeServed(NodeState& state) {
       if (j % (2 * stride) == stride) {
         t = Clock::now();
         std::uint64_t sent = 0;
-        sendSubImage(comp, j - stride, kTreeTag, {failure, failure ? core::Image() : acc}, state.settings.codec, &sent);
+        sendSubImage(comp, j - stride, kTreeTag, {failure, failure ? core::Image() : acc}, &sent);
         w.comm += secondsSince(t);
         break;
       }
@@ -161,13 +169,14 @@ void compositeServed(NodeState& state) {
     if (j == 0) {
       SubImage band{failure, {}};
       if (!failure) band.image = cropToRect(acc, bandRect(width, height, render.band, render.bands));
-      deliver(state, slot, render.band, band, w.comm);
+      deliver(state, slot, render.band, band, w.comm, failure);
     }
+    keepFirst(rankFailure, failure);
   }
 }
 
 // The collector takes every band of the wave from whoever finished it.
-void receiveBands(NodeState& state) {
+void receiveBands(NodeState& state, std::optional<comm::Failure>& failure) {
   for (int slot = 0; slot < int(state.wave.size()); ++slot) {
     for (int c : state.layout.renderClustersOf(slot)) {
       const ClusterPlan& render = state.layout.clusters[std::size_t(c)];
@@ -175,7 +184,7 @@ void receiveBands(NodeState& state) {
                                                : state.layout.clusters[std::size_t(render.compositor)].ranks[0];
       if (sender == 0) continue;  // delivered locally
       SubImage in = receiveSubImage(state.world, sender, kBandTag);
-      if (in.failure && !state.bandFailure) state.bandFailure = in.failure;
+      keepFirst(failure, in.failure);
       if (!in.failure) state.bands[{slot, render.band}] = std::move(in.image);
     }
   }
@@ -183,25 +192,17 @@ void receiveBands(NodeState& state) {
 
 }  // namespace
 
-void composite(NodeState& state, const ActionArgs&) {
+void compositeWave(NodeState& state, std::optional<comm::Failure>& failure) {
   state.bands.clear();
-  state.bandFailure.reset();
   const ClusterPlan* me = state.myCluster();
-  std::optional<comm::Failure> local;
-  try {
-    if (me && me->role == proto::ClusterRole::kRender && me->group < int(state.wave.size())) {
-      WaveFrame& w = state.wave[std::size_t(me->group)];
-      if (me->compositor < 0) compositeSelf(state, me->group, w);
-      else sendToCompositors(state, w);
-    } else if (me && me->role == proto::ClusterRole::kComposite) {
-      compositeServed(state);
-    }
-  } catch (...) {
-    local = comm::failureOf(std::current_exception(), state.world.rank());
+  if (me && me->role == proto::ClusterRole::kRender && me->group < int(state.wave.size())) {
+    WaveFrame& w = state.wave[std::size_t(me->group)];
+    if (me->compositor < 0) compositeSelf(state, me->group, w, failure);
+    else sendToCompositors(state, w, failure);
+  } else if (me && me->role == proto::ClusterRole::kComposite) {
+    compositeServed(state, failure);
   }
-  if (state.world.rank() == 0) receiveBands(state);
-  if (local) throw comm::FailureError(*local);
-  if (state.bandFailure) throw comm::FailureError(*state.bandFailure);
+  if (state.world.rank() == 0) receiveBands(state, failure);
 }
 
-}  // namespace pvr::node::actions
+}  // namespace pvr::node

@@ -1,0 +1,65 @@
+// wave: one wave of a request, one frame per group, in one command and one
+// agreement. Group g renders frames[g] (when there is one): every rank of
+// each of the group's render clusters ray-casts its brick, keeping the
+// scanlines of its cluster's band. Groups render their frames at the same
+// time (time-space parallelism); clusters of a group split the rows
+// (image-space parallelism). Then the sub-images become bands at the
+// collector (wave_composite.h), which sends the frames in order
+// (wave_collect.h).
+//
+// A failure in any step travels with the messages that step sends anyway
+// (a sub-image or band carries it), so no rank waits on one that gave up.
+// Every rank ends by throwing the first failure it knows of; the
+// dispatcher's one world agreement then reports the lowest rank's.
+#include <chrono>
+
+#include "../wave_collect.h"
+#include "../wave_composite.h"
+#include "table.h"
+
+namespace pvr::node::actions {
+
+namespace {
+
+// Local: ray-casts this rank's brick for its group's frame, if it has one.
+void renderMyFrame(NodeState& state, std::optional<comm::Failure>& failure) {
+  if (!state.renders()) return;
+  const ClusterPlan& me = *state.myCluster();
+  if (me.group >= int(state.wave.size())) return;
+  WaveFrame& w = state.wave[std::size_t(me.group)];
+  const int width = state.scene.image.width, height = state.scene.image.height;
+  try {
+    if (!state.renderer) throw Error(ErrorCode::kInvalidArgument, "no dataset: send SetScene with a dataset first");
+    state.maybeFail("render");
+    const auto start = std::chrono::steady_clock::now();
+    const core::Camera camera(w.camera, width, height);
+    // A cluster that shares the frame's scanlines with others casts only
+    // the rays of its own band.
+    const core::PixelRect band = bandRect(width, height, me.band, me.bands);
+    w.partial = state.renderer->render(camera, state.renderOptions, *state.pool, nullptr,
+                                       me.bands > 1 ? &band : nullptr);
+    w.rend = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  } catch (...) {
+    failure = comm::failureOf(std::current_exception(), state.world.rank());
+    w.partial = core::Image(width, height, core::PixelRect{});  // composites as nothing
+  }
+}
+
+}  // namespace
+
+void Wave::run(NodeState& state, const Wave& args) {
+  state.wave.clear();
+  for (const FrameView& f : args.frames) {
+    WaveFrame w;
+    w.number = f.number;
+    w.camera = cameraSpec(f.camera);
+    state.wave.push_back(std::move(w));
+  }
+  std::optional<comm::Failure> failure;
+  renderMyFrame(state, failure);
+  compositeWave(state, failure);
+  collectWave(state, args.request, args.lastFrame, failure);
+  if (failure) throw comm::FailureError(*failure);
+}
+
+}  // namespace pvr::node::actions

@@ -1,0 +1,148 @@
+#include "master.h"
+
+#include <algorithm>
+
+#include "dispatch.h"
+#include "rotation.h"
+#include "status.h"
+#include "wire_error.h"
+
+namespace pvr::node {
+
+namespace {
+
+using proto::ErrorCode;
+
+// Requests the master answers between the waves of a sequence.
+bool answeredAtOnce(const proto::Message& m) {
+  return std::holds_alternative<proto::StatusRequest>(m) || std::holds_alternative<proto::PerformanceRequest>(m) ||
+         std::holds_alternative<proto::Cancel>(m);
+}
+
+void requireDataset(const NodeState& state) {
+  if (!state.source) throw Error(pvr::ErrorCode::kInvalidArgument, "no dataset: send SetScene with a dataset first");
+}
+
+}  // namespace
+
+void Master::serve() {
+  while (link_.open()) {
+    std::optional<proto::Decoded> frame;
+    if (!pending_.empty()) {
+      frame = std::move(pending_.front());
+      pending_.pop_front();
+    } else {
+      frame = link_.next(true);
+    }
+    if (!frame) break;
+    handle(*frame);
+  }
+}
+
+void Master::handle(const proto::Decoded& frame) {
+  try {
+    std::visit([&](const auto& m) { on(m, frame.info.requestId); }, frame.message);
+  } catch (const Error& e) {
+    sendError(wireError(e), frame.info.requestId);
+  } catch (const std::exception& e) {
+    send(proto::ErrorMessage{ErrorCode::kInternal, e.what()}, frame.info.requestId);
+  }
+}
+
+void Master::on(const proto::Hello&, std::uint32_t id) {
+  send(proto::Welcome{"pvr-node 0.2", std::uint32_t(state_.world.size()), false}, id);
+}
+
+void Master::on(const proto::SessionOpen& m, std::uint32_t id) { layout(m.clusters, id); }
+
+void Master::on(const proto::SetLayout& m, std::uint32_t id) { layout(m.clusters, id); }
+
+void Master::layout(const std::vector<proto::ClusterSpec>& clusters, std::uint32_t id) {
+  if (auto f = invoke(state_, actions::SetLayout{clusters})) return sendError(wireError(*f), id);
+  send(proto::SessionReady{std::uint32_t(state_.world.size()), state_.layout.specs()}, id);
+}
+
+void Master::on(const proto::SetScene& request, std::uint32_t id) {
+  auto patched = patchScene(scene_, request, state_.dataDir);
+  if (const auto* refused = std::get_if<proto::ProtocolError>(&patched)) return sendError(*refused, id);
+  SessionScene& next = std::get<SessionScene>(patched);
+  // Without a volume there is nothing for the ranks to load yet: the
+  // checked scene waits for the dataset.
+  if (next.hasVolume()) {
+    if (auto f = invoke(state_, actions::SetScene{next.doc.dump(), next.settings})) return sendError(wireError(*f), id);
+  }
+  scene_ = std::move(next);
+  send(proto::Ok{}, id);
+}
+
+void Master::on(const proto::StatusRequest&, std::uint32_t id) {
+  send(proto::StatusReply{statusEntries(state_, {running_ != 0, framesSent_, scene_.settings})}, id);
+}
+
+void Master::on(const proto::RenderFrame&, std::uint32_t id) {
+  requireDataset(state_);
+  const core::CameraSpec camera = state_.scene.camera;
+  renderSequence(1, [&](int) { return camera; }, id);
+}
+
+void Master::on(const proto::RenderRotation& m, std::uint32_t id) {
+  const Rotation rotation(state_.scene.camera, m);
+  requireDataset(state_);
+  renderSequence(rotation.frames(), [&](int k) { return rotation.camera(k); }, id);
+}
+
+void Master::on(const proto::PerformanceRequest& p, std::uint32_t id) {
+  const std::int32_t cluster = p.cluster == proto::kAllClusters ? -1 : std::int32_t(p.cluster);
+  const auto failure = p.query == proto::PerformanceQuery::kMemory ? invoke(state_, actions::ReportMemory{cluster})
+                                                                    : invoke(state_, actions::CompLatency{cluster});
+  if (failure) return sendError(wireError(*failure), id);
+  send(proto::PerformanceReply{p.query, state_.reply.dump()}, id);
+}
+
+void Master::on(const proto::Cancel& m, std::uint32_t id) {
+  // Requests run one at a time: any target but the running one has finished.
+  if (running_ != 0 && m.target == running_) cancelled_ = true;
+  send(proto::Ok{}, id);
+}
+
+void Master::on(const proto::Close&, std::uint32_t) { link_.close(); }
+
+template <class M>
+void Master::on(const M&, std::uint32_t id) {
+  send(proto::ErrorMessage{ErrorCode::kUnsupported, std::string(M::kWire.name) + " is not served by pvr-node"}, id);
+}
+
+void Master::renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf, std::uint32_t id) {
+  running_ = id;
+  cancelled_ = false;
+  state_.sendFrame = [&](proto::ImageFrame&& f, bool final) {
+    ++framesSent_;
+    send(f, id, final);
+  };
+  const int groups = state_.layout.groups;
+  for (int first = 0; first < count && link_.open(); first += groups) {
+    actions::Wave wave;
+    wave.request = id;
+    wave.lastFrame = std::uint32_t(count - 1);
+    for (int k = first; k < std::min(count, first + groups); ++k)
+      wave.frames.push_back({std::uint32_t(k), cameraArgs(cameraOf(k))});
+    if (auto f = invoke(state_, wave)) {
+      sendError(wireError(*f), id);
+      break;
+    }
+    // Between waves: answer what must not wait; keep the rest for later.
+    while (auto frame = link_.next(false)) {
+      if (answeredAtOnce(frame->message)) handle(*frame);
+      else pending_.push_back(std::move(*frame));
+    }
+    if (cancelled_ && first + groups < count) {
+      send(proto::ErrorMessage{ErrorCode::kCancelled, "cancelled after " + std::to_string(first + groups) + " frames"},
+           id);
+      break;
+    }
+  }
+  state_.sendFrame = nullptr;
+  running_ = 0;
+}
+
+}  // namespace pvr::node

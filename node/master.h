@@ -1,0 +1,60 @@
+// The master rank's side of a session: it reads protocol messages from its
+// link to the pvrd session handler and answers each, turning the work into
+// actions every rank runs (dispatch.h, actions/table.h). Requests run one
+// at a time, in order. While a sequence renders, between its waves, the
+// master answers Status, Performance and Cancel at once and keeps any
+// other request for after the sequence.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+
+#include "node.h"
+#include "pvrd_link.h"
+#include "scene_patch.h"
+
+namespace pvr::node {
+
+class Master {
+ public:
+  Master(NodeState& state, PvrdLink& link) : state_(state), link_(link) {}
+  // Serves until the link closes or the client sends Close.
+  void serve();
+
+ private:
+  void send(const proto::Message& m, std::uint32_t id, bool final = true) { link_.send(m, id, final); }
+  void sendError(const proto::ProtocolError& e, std::uint32_t id) { send(proto::ErrorMessage{e.code, e.text}, id); }
+  // Answers one request; an error it throws becomes the request's Error.
+  void handle(const proto::Decoded& frame);
+
+  // One handler per message the master serves, `id` the request's; the
+  // template answers every other message with Error UNSUPPORTED.
+  void on(const proto::Hello& m, std::uint32_t id);
+  void on(const proto::SessionOpen& m, std::uint32_t id);
+  void on(const proto::SetLayout& m, std::uint32_t id);
+  void on(const proto::SetScene& m, std::uint32_t id);
+  void on(const proto::StatusRequest& m, std::uint32_t id);
+  void on(const proto::RenderFrame& m, std::uint32_t id);
+  void on(const proto::RenderRotation& m, std::uint32_t id);
+  void on(const proto::PerformanceRequest& m, std::uint32_t id);
+  void on(const proto::Cancel& m, std::uint32_t id);
+  void on(const proto::Close& m, std::uint32_t id);
+  template <class M>
+  void on(const M& m, std::uint32_t id);
+
+  void layout(const std::vector<proto::ClusterSpec>& clusters, std::uint32_t id);
+  // Renders frames 0 .. count - 1, frame k seen by cameraOf(k), in waves of
+  // one frame per group; the request's frames go out in order, the last FINAL.
+  void renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf, std::uint32_t id);
+
+  NodeState& state_;
+  PvrdLink& link_;
+  std::deque<proto::Decoded> pending_;  // requests that arrived during a sequence
+  SessionScene scene_;
+  std::uint32_t framesSent_ = 0;
+  std::uint32_t running_ = 0;  // request id of the sequence in progress; 0: none
+  bool cancelled_ = false;
+};
+
+}  // namespace pvr::node

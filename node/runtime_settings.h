@@ -1,0 +1,36 @@
+// Session settings a client sets through the "runtime" object of a SetScene
+// document (docs/runtime.md). The master reads them from the merged object
+// and sends them to every rank with the scene (actions::SetScene).
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <tuple>
+
+#include "distribute.h"
+#include "pvr_protocol.h"
+
+namespace pvr::node {
+
+struct RuntimeSettings {
+  std::string strategy = "binary-swap";  // self-compositing clusters; a registered strategy
+  Decomposition decomposition = Decomposition::kKd;
+  double rebalanceThreshold = 1.2;  // max/mean content per rank that triggers a rebalance
+  proto::PixelFormat format = proto::PixelFormat::kRgba8;
+  proto::Compression compression = proto::Compression::kZlib;
+  std::int32_t threads = 1;  // render threads per rank
+  static auto fields(auto& self) {
+    return std::tie(self.strategy, self.decomposition, self.rebalanceThreshold, self.format, self.compression,
+                    self.threads);
+  }
+  bool operator==(const RuntimeSettings&) const = default;
+};
+
+// The settings a "runtime" object gives over the defaults. Throws
+// pvr::Error (kInvalidArgument) naming the key and what it accepts: an
+// unknown key, a wrong type, an unknown strategy (with the registered
+// ones), decomposition, pixel format or compression.
+RuntimeSettings settingsFrom(const nlohmann::json& runtime);
+
+}  // namespace pvr::node

@@ -1,0 +1,94 @@
+#include "status.h"
+
+#include <unistd.h>
+
+#include <charconv>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+
+#include "strategy.h"
+
+namespace pvr::node {
+
+namespace {
+
+// The shortest text that reads back as the same double: full precision.
+std::string number(double v) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, v).ptr;
+  return std::string(text, end);
+}
+
+// Appends `item` to the Tcl list `out`.
+void append(std::string& out, std::string_view item) {
+  if (!out.empty()) out += ' ';
+  out += item;
+}
+
+// Numbers as a Tcl list.
+std::string list(std::initializer_list<double> values) {
+  std::string out;
+  for (double v : values) append(out, number(v));
+  return out;
+}
+
+std::string list(const core::Vec3& v) { return list({v.x, v.y, v.z}); }
+
+std::string strategyNames() {
+  std::string out;
+  for (const auto& s : composite::strategies()) append(out, s.name);
+  return out;
+}
+
+std::string decompositionNames() {
+  std::string out;
+  for (const auto& d : decompositions()) append(out, d.name);
+  return out;
+}
+
+// The keys that describe the loaded dataset as it is rendered.
+void addDataset(const NodeState& state, std::vector<proto::KeyValue>& out) {
+  const core::CameraSpec& camera = state.scene.camera;  // resolved: the automatic camera is filled in
+  const bool perspective = camera.projection == core::Projection::kPerspective;
+  out.push_back({"camera_projection", perspective ? "perspective" : "orthographic"});
+  out.push_back({"camera_eye", list(camera.eye)});
+  out.push_back({"camera_look_at", list(camera.lookAt)});
+  out.push_back({"camera_up", list(camera.up)});
+  if (perspective) out.push_back({"camera_fov_y_deg", number(camera.fovYDeg)});
+  if (!perspective || camera.height > 0) out.push_back({"camera_height", number(camera.height)});
+  out.push_back({"image_size", list({double(state.scene.image.width), double(state.scene.image.height)})});
+  const core::GridGeometry& grid = state.source->grid();
+  const core::Vec3 lo = grid.domainMin(), hi = grid.domainMax();
+  out.push_back({"bounds", list({lo.x, lo.y, lo.z, hi.x, hi.y, hi.z})});
+  if (state.valueRange) out.push_back({"value_range", list({(*state.valueRange)[0], (*state.valueRange)[1]})});
+  std::string points;
+  for (const core::TransferPoint& p : state.scene.transfer.points)
+    append(points, list({p.scalar, p.r, p.g, p.b, p.opacity}));
+  out.push_back({"transfer_function", points});
+}
+
+}  // namespace
+
+std::vector<proto::KeyValue> statusEntries(const NodeState& state, const SessionStatus& session) {
+  const RuntimeSettings& settings = session.settings;
+  std::vector<proto::KeyValue> out{
+      {"state", session.rendering ? "rendering" : "session open"},
+      {"ranks", std::to_string(state.world.size())},
+      {"master_pid", std::to_string(::getpid())},
+      {"clusters", std::to_string(state.layout.clusters.size())},
+      {"groups", std::to_string(state.layout.groups)},
+      {"dataset", state.source ? state.source->describe() : ""},
+      {"frames_rendered", std::to_string(session.framesSent)},
+      {"rebalances", std::to_string(state.rebalances)},
+      {"imbalance", number(state.imbalance)},
+      {"strategies", strategyNames()},
+      {"decompositions", decompositionNames()},
+      {"strategy", settings.strategy},
+      {"decomposition", std::string(decompositionName(settings.decomposition))},
+  };
+  if (state.source) addDataset(state, out);
+  return out;
+}
+
+}  // namespace pvr::node

@@ -1,0 +1,23 @@
+// The collecting step of a wave (actions::Wave): every rank contributes its
+// timings, and the collector (world rank 0) assembles the bands into
+// frames, converts them to 8-bit sRGB over the background, compresses and
+// sends them to the client in frame order.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+
+#include "node.h"
+
+namespace pvr::node {
+
+// Collective over the world. Each frame carries rend, comp and comm as the
+// max over ranks and send as the collector measured it; the wave's first
+// frame also carries dist: the command's broadcast plus the slowest rank's
+// (re)distribution since the last frame. The collector sends nothing when
+// it knows of a failure (`failure`, its own or a band's); a failure while
+// sending goes into `failure` and stops it.
+void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame,
+                 std::optional<comm::Failure>& failure);
+
+}  // namespace pvr::node

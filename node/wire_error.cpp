@@ -1,0 +1,26 @@
+#include "wire_error.h"
+
+namespace pvr::node {
+
+namespace {
+
+proto::ErrorCode wireCode(pvr::ErrorCode code) {
+  using proto::ErrorCode;
+  switch (code) {
+    case pvr::ErrorCode::kInvalidArgument: return ErrorCode::kBadArgument;
+    case pvr::ErrorCode::kBadFile: return ErrorCode::kBadFile;
+    case pvr::ErrorCode::kIo: return ErrorCode::kIo;
+    case pvr::ErrorCode::kUnsupported: return ErrorCode::kUnsupported;
+    case pvr::ErrorCode::kRemote: return ErrorCode::kRankFailed;
+    case pvr::ErrorCode::kInternal: return ErrorCode::kInternal;
+  }
+  return ErrorCode::kInternal;
+}
+
+}  // namespace
+
+proto::ProtocolError wireError(const pvr::Error& error) { return {wireCode(error.code()), error.what()}; }
+
+proto::ProtocolError wireError(const comm::Failure& failure) { return {wireCode(failure.code), failure.describe()}; }
+
+}  // namespace pvr::node
