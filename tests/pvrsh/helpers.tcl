@@ -2,7 +2,9 @@
 # temporary data directory, and pvrd started on an ephemeral loopback port.
 #
 # The environment (set by tests/pvrsh/CMakeLists.txt) names the programs:
-# PVRD, PVR_NODE (pvr-node), PVR_RENDER, PVR_TEST_TMP.
+# PVRD, PVR_NODE (pvr-node), PVRSH, PVR_RENDER, and PVR_TEST_TMP. A test file
+# that needs a program asks ::pvrtest::program for it: a file registered
+# without its programs fails instead of skipping its tests.
 
 package require tcltest 2
 namespace import ::tcltest::*
@@ -13,6 +15,18 @@ namespace eval ::pvrtest {
     variable pvrd ""        ;# channel of the running pvrd
     variable pvrdPid 0
     variable port 0
+}
+
+# ::pvrtest::program VAR: the program the environment variable VAR names;
+# an error when it is not set or not executable.
+proc ::pvrtest::program {var} {
+    if {![info exists ::env($var)]} {
+        error "this test needs the program named by \$$var, which is not set (tests/pvrsh/CMakeLists.txt sets it)"
+    }
+    if {![file executable $::env($var)]} {
+        error "\$$var names $::env($var), which is not an executable (build it first)"
+    }
+    return $::env($var)
 }
 
 # ::pvrtest::makeData DIR: writes ball/ball.raw + ball.json, a 32^3 uint8
@@ -48,7 +62,7 @@ proc ::pvrtest::startPvrd {args} {
     variable pvrdPid
     variable port
     set data [makeData [file join $tmp data]]
-    set cmd [list $::env(PVRD) --listen 127.0.0.1:0 --data-dir $data --node $::env(PVR_NODE) {*}$args]
+    set cmd [list [program PVRD] --listen 127.0.0.1:0 --data-dir $data --node [program PVR_NODE] {*}$args]
     set pvrd [open |[concat $cmd [list 2>> [file join $tmp pvrd.log]]] r]
     set pvrdPid [pid $pvrd]
     gets $pvrd line
