@@ -92,6 +92,38 @@ proc ::pvrtest::killPvrd {} {
     set pvrdPid 0
 }
 
+# ::pvrtest::near GOT WANT ?TOLERANCE?: 1 when the number lists GOT and WANT
+# have the same length and agree element by element within TOLERANCE.
+proc ::pvrtest::near {got want {tolerance 1e-9}} {
+    if {[llength $got] != [llength $want]} {
+        return 0
+    }
+    foreach a $got b $want {
+        if {![string is double -strict $a] || abs($a - $b) > $tolerance} {
+            return 0
+        }
+    }
+    return 1
+}
+
+# ::pvrtest::maxDiff A B: the largest difference of any 8-bit channel
+# between the Tk photo images A and B of one size (needs Tk).
+proc ::pvrtest::maxDiff {a b} {
+    if {[image width $a] != [image width $b] || [image height $a] != [image height $b]} {
+        error "images $a and $b differ in size"
+    }
+    set worst 0
+    for {set y 0} {$y < [image height $a]} {incr y} {
+        for {set x 0} {$x < [image width $a]} {incr x} {
+            foreach p [$a get $x $y] q [$b get $x $y] {
+                set d [expr {abs($p - $q)}]
+                if {$d > $worst} { set worst $d }
+            }
+        }
+    }
+    return $worst
+}
+
 # ::pvrtest::errorcode SCRIPT: the -errorcode of SCRIPT's error, or "ok".
 proc ::pvrtest::errorcode {script} {
     if {[catch {uplevel 1 $script} msg opts]} {
