@@ -1,6 +1,7 @@
 #include "scene_options.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -154,8 +155,10 @@ void setProjection(Apply& a) {
 // -strategy NAME, -decomposition NAME: runtime settings of the node
 // (docs/runtime.md). The names are the server's; with a session open and
 // idle they are checked against its list for a clear error here.
+// Errors: {PVR ARGS STRATEGY}, {PVR ARGS DECOMPOSITION}.
 void setRuntimeName(Apply& a, const char* key, std::string_view listKey) {
-  const std::string what = a.option.substr(1);
+  std::string what = a.option.substr(1);
+  std::transform(what.begin(), what.end(), what.begin(), [](unsigned char c) { return char(std::toupper(c)); });
   if (a.value.empty()) argsError(what, a.option + " needs a name");
   if (const auto known = a.serverNames ? a.serverNames(listKey) : std::nullopt)
     if (std::find(known->begin(), known->end(), a.value) == known->end()) {
