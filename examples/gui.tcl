@@ -7,11 +7,14 @@
 # Connect; PVR_SERVER sets the default). -dataset picks a catalog entry (a
 # directory name picks the sidecar inside it). -datadir is pvrd's data
 # directory when this machine can read it: the transfer-function editor then
-# shows the dataset's scalar range and histogram.
+# shows the dataset's histogram.
 #
-# Drag the image to turn the view; the arrows turn it by 15 degrees. The
-# transfer-function editor applies every change at once. "Clusters and
-# groups" sets -cluster/-group; the second window graphs each frame's times.
+# Drag the image to turn the view about the camera the server reports; the
+# arrows turn it by 15 degrees. The transfer-function editor spans the
+# data's value range and applies every change at once; "Preset..." loads a
+# ParaView preset. "Clusters and groups" sets -cluster/-group and the
+# compositing strategy and decomposition, from the names the server
+# offers; the second window graphs each frame's times.
 package require Tk
 if {[catch {package require pvr}]} {
     # Under plain wish: the package from the build tree.

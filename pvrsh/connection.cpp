@@ -114,10 +114,7 @@ void Connection::finishConnect() {
   if (timer_) Tcl_DeleteTimerHandler(timer_);
   timer_ = nullptr;
   state_ = State::kConnected;
-  updateMask();
-  const std::shared_ptr<bool> alive = alive_;
-  listener_.onConnected();
-  if (*alive) writeSome();
+  writeSome();  // frames queued while connecting; updates the mask
 }
 
 bool Connection::send(const proto::Message& message, std::uint32_t requestId) {

@@ -22,19 +22,19 @@ namespace pvr::tcl {
 class Connection {
  public:
   // What the owner hears. A listener may destroy the Connection from inside
-  // any of these calls; the connection notices and touches nothing after.
+  // either call; the connection notices and touches nothing after.
   class Listener {
    public:
     virtual ~Listener() = default;
-    virtual void onConnected() = 0;                            // the TCP connect finished
     virtual void onMessage(const proto::Decoded& message) = 0; // one decoded frame
     virtual void onFailure(const TclError& error) = 0;         // once; the socket is closed after it
   };
 
-  // Resolves `host` and starts a non-blocking connect; onConnected or
-  // onFailure follows from the event loop, onFailure with {PVR CONNECT
-  // TIMEOUT} after `timeoutSeconds`. Throws TclError {PVR CONNECT RESOLVE}
-  // or {PVR CONNECT SOCKET} for failures known at once.
+  // Resolves `host` and starts a non-blocking connect. From the event loop
+  // the connect then finishes (connected() turns true, and frames queued by
+  // send meanwhile go out) or fails: onFailure, with {PVR CONNECT TIMEOUT}
+  // after `timeoutSeconds`. Throws TclError {PVR CONNECT RESOLVE},
+  // {PVR CONNECT REFUSED} or {PVR CONNECT SOCKET} for failures known at once.
   Connection(Listener& listener, const std::string& host, int port, double timeoutSeconds);
   ~Connection();
   Connection(const Connection&) = delete;
@@ -46,7 +46,6 @@ class Connection {
 
   bool connected() const { return state_ == State::kConnected; }
   bool failed() const { return state_ == State::kFailed; }
-  const std::string& peer() const { return peer_; }
 
  private:
   enum class State { kConnecting, kConnected, kFailed };

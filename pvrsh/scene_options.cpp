@@ -1,10 +1,11 @@
 #include "scene_options.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
-#include <optional>
+#include <cstdint>
 #include <fstream>
-#include <set>
+#include <optional>
 
 #include "tcl_util.h"
 
@@ -34,6 +35,7 @@ struct Apply {
   SettingsChange& change;
   const std::string& option;  // "-imagesz"
   const std::string& value;   // as given
+  const ServerNames& serverNames;
 
   void scene(const json& patch) {
     mergeKeepingNulls(change.patch, patch);
@@ -82,12 +84,20 @@ void setLayout(Settings& s, proto::ClusterRole role, std::uint32_t ranks, const 
 
 void setScalar(Apply& a, const char* section, const char* key, double v) { a.scene({{section, {{key, v}}}}); }
 
+// The frames of a session are rgba8: the node's default pixel format
+// (docs/runtime.md, runtime.pixels), which pvrsh never changes.
+constexpr proto::PixelFormat kSessionPixelFormat = proto::PixelFormat::kRgba8;
+
+// -imagesz W,H: any size the protocol's one rule for image sizes accepts.
 void setImageSize(Apply& a) {
   const auto v = a.numbers(2);
   for (double d : v)
-    if (d != std::floor(d) || d < 1 || d > 16384)
-      argsError("IMAGESZ", "-imagesz needs two integers in 1..16384 (W,H), got '" + a.value + "'");
-  a.scene({{"image", {{"width", int(v[0])}, {"height", int(v[1])}}}});
+    if (d != std::floor(d)) argsError("IMAGESZ", "-imagesz needs two integers (W,H), got '" + a.value + "'");
+  // Past 2^53 a double is no longer every integer; checkImageSize refuses far less.
+  const auto side = [](double d) { return d < 0 ? 0 : std::uint64_t(std::min(d, 9007199254740992.0)); };
+  if (const auto error = proto::checkImageSize(side(v[0]), side(v[1]), kSessionPixelFormat))
+    argsError("IMAGESZ", "-imagesz " + a.value + ": " + error->text);
+  a.scene({{"image", {{"width", std::int64_t(v[0])}, {"height", std::int64_t(v[1])}}}});
 }
 
 void setBackground(Apply& a) {
@@ -99,17 +109,37 @@ void setBackground(Apply& a) {
   a.scene({{"image", {{"background", v}}}});
 }
 
+// A transfer function has exactly one source (docs/scene.md): setting one
+// deletes the others, so a merge patch never leaves two behind.
+json transferSource(const char* key, json value) {
+  json tf = {{"points", nullptr}, {"paraview_preset", nullptr}, {"paraview", nullptr}};
+  tf[key] = std::move(value);
+  return {{"transfer_function", tf}};
+}
+
 void setTransferPoints(Apply& a) {
-  const auto v = a.numbers(-1);
+  const auto v = parseListNumbers(a.option, a.value);
   if (v.empty() || v.size() % 5 != 0)
     argsError("TF", "-tf needs control points {scalar r g b opacity} ..., a multiple of 5 numbers, got " +
                         std::to_string(v.size()));
   json points = json::array();
   for (std::size_t i = 0; i < v.size(); i += 5) points.push_back({v[i], v[i + 1], v[i + 2], v[i + 3], v[i + 4]});
-  a.scene({{"transfer_function", {{"points", points}}}});
+  a.scene(transferSource("points", points));
 }
 
-void setTransferPreset(Apply& a) { a.scene({{"transfer_function", {{"points", presetPoints(a.value)}}}}); }
+// -tfpreset FILE: the file's JSON goes to the server as it is, and the
+// renderer's one preset reader reads it there (docs/scene.md, "ParaView
+// presets"). A preset object is sent as a one-element array, a form the
+// reader takes too, because a merge patch replaces an array whole where it
+// would merge an object into the preset set before.
+void setTransferPreset(Apply& a) {
+  std::ifstream in(a.value);
+  if (!in) argsError("TFPRESET", "-tfpreset: cannot read " + a.value);
+  json preset = json::parse(in, nullptr, false);
+  if (preset.is_discarded()) argsError("TFPRESET", "-tfpreset: " + a.value + " is not JSON");
+  if (!preset.is_array()) preset = json::array({std::move(preset)});
+  a.scene(transferSource("paraview", std::move(preset)));
+}
 
 void setCamera(Apply& a) {
   if (a.value != "auto") argsError("CAMERA", "-camera takes 'auto' (set -eye, -lookat, -up for a fixed camera)");
@@ -122,17 +152,22 @@ void setProjection(Apply& a) {
   a.scene({{"camera", {{"projection", a.value}}}});
 }
 
-void setStrategy(Apply& a) {
-  static const std::set<std::string> known{"binary-swap", "direct-send", "tree", "radix-k", "pipeline"};
-  if (!known.count(a.value))
-    argsError("STRATEGY", "-strategy takes binary-swap, direct-send, tree, radix-k or pipeline, got '" + a.value + "'");
-  a.scene({{"parallel", {{"strategy", a.value}}}});
-}
-
-void setDecomposition(Apply& a) {
-  if (a.value != "kd" && a.value != "balanced")
-    argsError("DECOMPOSITION", "-decomposition takes kd or balanced, got '" + a.value + "'");
-  a.scene({{"parallel", {{"decomposition", a.value}}}});
+// -strategy NAME, -decomposition NAME: runtime settings of the node
+// (docs/runtime.md). The names are the server's; with a session open and
+// idle they are checked against its list for a clear error here.
+// Errors: {PVR ARGS STRATEGY}, {PVR ARGS DECOMPOSITION}.
+void setRuntimeName(Apply& a, const char* key, std::string_view listKey) {
+  std::string what = a.option.substr(1);
+  std::transform(what.begin(), what.end(), what.begin(), [](unsigned char c) { return char(std::toupper(c)); });
+  if (a.value.empty()) argsError(what, a.option + " needs a name");
+  if (const auto known = a.serverNames ? a.serverNames(listKey) : std::nullopt)
+    if (std::find(known->begin(), known->end(), a.value) == known->end()) {
+      std::string names;
+      for (std::size_t i = 0; i < known->size(); ++i)
+        names += (i == 0 ? "" : i + 1 == known->size() ? " or " : ", ") + (*known)[i];
+      argsError(what, a.option + ": the server offers " + names + ", not '" + a.value + "'");
+    }
+  a.scene({{"runtime", {{key, a.value}}}});
 }
 
 struct OptionRow {
@@ -165,8 +200,8 @@ const OptionRow kOptions[] = {
     {"-specular", [](Apply& a) { setScalar(a, "shading", "specular", a.number()); }},
     {"-shininess", [](Apply& a) { setScalar(a, "shading", "shininess", a.positive()); }},
     {"-light", [](Apply& a) { a.scene({{"shading", {{"light_direction", a.vec3()}}}}); }},
-    {"-strategy", setStrategy},
-    {"-decomposition", setDecomposition},
+    {"-strategy", [](Apply& a) { setRuntimeName(a, "strategy", "strategies"); }},
+    {"-decomposition", [](Apply& a) { setRuntimeName(a, "decomposition", "decompositions"); }},
     {nullptr, nullptr}};
 
 void remember(Settings& s, const std::string& option, const std::string& value) {
@@ -178,76 +213,10 @@ void remember(Settings& s, const std::string& option, const std::string& value) 
   s.shown.emplace_back(option, value);
 }
 
-// Linear interpolation of (x, value) points at x, clamped outside; at a jump
-// (equal x) `right` picks the last point of that x, otherwise the first.
-std::vector<double> evaluate(const std::vector<std::pair<double, std::vector<double>>>& f, double x, bool right) {
-  if (x < f.front().first) return f.front().second;
-  if (x > f.back().first) return f.back().second;
-  std::size_t i = 0;
-  while (f[i].first < x) ++i;  // first point at or after x; one exists
-  if (f[i].first == x) {
-    if (right)
-      while (i + 1 < f.size() && f[i + 1].first == x) ++i;
-    return f[i].second;
-  }
-  const auto& [x0, v0] = f[i - 1];
-  const auto& [x1, v1] = f[i];
-  const double t = (x - x0) / (x1 - x0);
-  std::vector<double> out(v0.size());
-  for (std::size_t k = 0; k < v0.size(); ++k) out[k] = v0[k] + t * (v1[k] - v0[k]);
-  return out;
-}
-
 }  // namespace
 
-json presetPoints(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) argsError("TFPRESET", "-tfpreset: cannot read " + path);
-  json doc;
-  try {
-    doc = json::parse(in);
-  } catch (const std::exception& e) {
-    argsError("TFPRESET", "-tfpreset: " + path + " is not JSON: " + e.what());
-  }
-  if (doc.is_array() && !doc.empty()) doc = doc[0];
-  const auto bad = [&](const std::string& why) { argsError("TFPRESET", "-tfpreset: " + path + ": " + why); };
-  if (!doc.is_object() || !doc.contains("RGBPoints") || !doc["RGBPoints"].is_array()) bad("no RGBPoints array");
-  // Colour and opacity as two piecewise-linear functions of the scalar.
-  std::vector<std::pair<double, std::vector<double>>> colour, opacity;
-  const auto& rgb = doc["RGBPoints"];
-  if (rgb.empty() || rgb.size() % 4 != 0) bad("RGBPoints needs x, r, g, b quadruples");
-  try {
-    for (std::size_t i = 0; i < rgb.size(); i += 4)
-      colour.push_back({rgb[i].get<double>(), {rgb[i + 1].get<double>(), rgb[i + 2].get<double>(), rgb[i + 3].get<double>()}});
-    if (doc.contains("Points")) {
-      const auto& pts = doc["Points"];
-      if (!pts.is_array() || pts.empty() || pts.size() % 4 != 0) bad("Points needs x, opacity, midpoint, sharpness quadruples");
-      for (std::size_t i = 0; i < pts.size(); i += 4) opacity.push_back({pts[i].get<double>(), {pts[i + 1].get<double>()}});
-    } else {
-      opacity = {{colour.front().first, {0.0}}, {colour.back().first, {1.0}}};
-    }
-  } catch (const json::exception&) {
-    bad("RGBPoints and Points must hold numbers");
-  }
-  for (const auto* f : {&colour, &opacity})
-    for (std::size_t i = 1; i < f->size(); ++i)
-      if ((*f)[i].first < (*f)[i - 1].first) bad("points must be sorted by scalar");
-
-  // One control point per scalar of either function; two where either jumps.
-  std::set<double> xs;
-  for (const auto& p : colour) xs.insert(p.first);
-  for (const auto& p : opacity) xs.insert(p.first);
-  json points = json::array();
-  for (double x : xs) {
-    const auto cl = evaluate(colour, x, false), cr = evaluate(colour, x, true);
-    const auto ol = evaluate(opacity, x, false), orr = evaluate(opacity, x, true);
-    points.push_back({x, cl[0], cl[1], cl[2], std::clamp(ol[0], 0.0, 1.0)});
-    if (cl != cr || ol != orr) points.push_back({x, cr[0], cr[1], cr[2], std::clamp(orr[0], 0.0, 1.0)});
-  }
-  return points;
-}
-
-SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tcl_Obj* const objv[]) {
+SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tcl_Obj* const objv[],
+                            const ServerNames& serverNames) {
   Settings next = settings;
   SettingsChange change;
   std::optional<std::string> cluster, group;
@@ -263,7 +232,7 @@ SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tc
     } else if (option == "-group") {
       group = value;
     } else {
-      Apply a{next, change, option, value};
+      Apply a{next, change, option, value, serverNames};
       kOptions[index].apply(a);
     }
     remember(next, option, value);
@@ -317,25 +286,6 @@ Tcl_Obj* layoutObj(const std::vector<proto::ClusterSpec>& clusters) {
     Tcl_ListObjAppendElement(nullptr, list, Tcl_NewListObj(3, item));
   }
   return list;
-}
-
-Tcl_Obj* jsonToTcl(const nlohmann::json& value) {
-  if (value.is_object()) {
-    Tcl_Obj* dict = Tcl_NewDictObj();
-    for (const auto& [k, v] : value.items()) Tcl_DictObjPut(nullptr, dict, Tcl_NewStringObj(k.c_str(), -1), jsonToTcl(v));
-    return dict;
-  }
-  if (value.is_array()) {
-    Tcl_Obj* list = Tcl_NewListObj(0, nullptr);
-    for (const auto& v : value) Tcl_ListObjAppendElement(nullptr, list, jsonToTcl(v));
-    return list;
-  }
-  if (value.is_null()) return Tcl_NewObj();
-  if (value.is_boolean()) return Tcl_NewBooleanObj(value.get<bool>());
-  if (value.is_number_integer()) return Tcl_NewWideIntObj(Tcl_WideInt(value.get<std::int64_t>()));
-  if (value.is_number()) return Tcl_NewDoubleObj(value.get<double>());
-  const std::string s = value.get<std::string>();
-  return Tcl_NewStringObj(s.data(), int(s.size()));
 }
 
 }  // namespace pvr::tcl

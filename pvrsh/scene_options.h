@@ -1,14 +1,16 @@
 // The options of `:s set`: each maps to a piece of a SetScene document
-// (docs/scene.md, sent as an RFC 7386 merge patch) or to the cluster layout
-// (SetLayout). One table row per option in scene_options.cpp.
+// (docs/scene.md and the "runtime" object of docs/runtime.md, sent as an
+// RFC 7386 merge patch) or to the cluster layout (SetLayout). One table row
+// per option in scene_options.cpp.
 #pragma once
 
 #include <tcl.h>
 
-#include <cstdint>
-#include <map>
+#include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "pvr_protocol.h"
@@ -30,25 +32,25 @@ struct SettingsChange {
   bool layout = false;                               // -cluster or -group given
 };
 
+// The names the server accepts, by status key (`strategies`,
+// `decompositions`; docs/protocol.md, StatusReply); nullopt when no server
+// can say now (no session open, a render in flight, an older server). pvrsh
+// keeps no list of its own: a name the server does not know is then refused
+// by the server.
+using ServerNames = std::function<std::optional<std::vector<std::string>>(std::string_view statusKey)>;
+
 // Applies `set` options (name value pairs) to `settings`. All options are
 // checked before any is applied, so a bad one changes nothing. Throws
 // TclError {PVR ARGS OPTION} with a message naming the option and value, and
 // the standard "bad option" message for an unknown option.
-SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tcl_Obj* const objv[]);
+SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tcl_Obj* const objv[],
+                            const ServerNames& serverNames);
 
 // The value last given for `option` (e.g. "-imagesz"), or an error naming
 // the known options.
 std::string shownOption(Tcl_Interp* interp, const Settings& settings, Tcl_Obj* option);
 
-// The control points [[s, r, g, b, a], ...] of a ParaView transfer-function
-// preset file (docs/scene.md, "ParaView presets"), read here so that the
-// server needs no access to the client's files.
-nlohmann::json presetPoints(const std::string& path);
-
 // A cluster layout as a Tcl list of {role ranks group} triples.
 Tcl_Obj* layoutObj(const std::vector<proto::ClusterSpec>& clusters);
-
-// A JSON value as Tcl: objects become dicts, arrays lists, null "".
-Tcl_Obj* jsonToTcl(const nlohmann::json& value);
 
 }  // namespace pvr::tcl

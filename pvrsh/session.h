@@ -9,16 +9,28 @@
 // Lifetime: the object command's delete proc calls Tcl_EventuallyFree, and
 // every entry from Tcl (commands, file handlers) brackets its work with
 // Tcl_Preserve/Tcl_Release, so a callback may delete the session it runs in.
+//
+// The methods live in one file per job:
+//   session.cpp           lifetime, requests out, waiting for answers
+//   session_open.cpp      open: connect, Hello, token challenge, SessionOpen
+//   session_arrivals.cpp  what comes back: replies, errors, the end of a sequence
+//   frame_delivery.cpp    a frame into the photo, files and the callback
+//   sequence_report.cpp   timings: progress lines, tables, Tcl dicts
+//   session_status.cpp    `list status` and the server's status entries
+//   session_commands.cpp  the subcommands (paper 003, Table 1)
 #pragma once
 
 #include <tcl.h>
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "connection.h"
@@ -81,9 +93,12 @@ class Session : public Connection::Listener {
   Tcl_Obj* timingObj() const;
   // Throws {PVR STATE NOTOPEN} naming `what` unless the session is open.
   void requireOpen(const char* what) const;
+  // The names in the server's status entry `key` (a Tcl list, e.g.
+  // `strategies`), or nullopt when the server cannot say now: the session
+  // is not open, a sequence is in flight, or the server has no such entry.
+  std::optional<std::vector<std::string>> serverNames(std::string_view key);
 
   // ---- Connection::Listener ----
-  void onConnected() override {}
   void onMessage(const proto::Decoded& message) override;
   void onFailure(const TclError& error) override;
 
@@ -103,16 +118,20 @@ class Session : public Connection::Listener {
 
  private:
   std::uint32_t send(const proto::Message& message, bool synchronous);
+  // The server's status entries, or nullopt when it cannot answer at once
+  // (not open, or a sequence in flight: the master answers between waves).
+  std::optional<std::vector<proto::KeyValue>> serverStatus();
   void handleFrame(Sequence& seq, const proto::ImageFrame& frame, bool final);
+  void runImageCallback(const FrameRecord& record);
   void finishSequence(std::uint32_t id);
   void report(const TclError& error);
   void notify(const char* event, std::vector<Tcl_Obj*> details);
   void printProgress(const Sequence& seq) const;
   void printTable(const Sequence& seq) const;
   void assembleAnimation(const Sequence& seq);
-  // Runs the event loop until done() or `timeoutSeconds` pass; false on timeout.
-  template <class Done>
-  bool runEventsUntil(Done done, double timeoutSeconds);
+  // Runs the event loop until done() or `timeoutSeconds` pass; false on
+  // timeout. Throws {PVR STATE DELETED} when the session is deleted meanwhile.
+  bool runEventsUntil(const std::function<bool()>& done, double timeoutSeconds);
 
   State state_ = State::kClosed;
   std::unique_ptr<Connection> conn_;
@@ -124,17 +143,27 @@ class Session : public Connection::Listener {
   std::uint32_t nextId_ = 1;
   std::map<std::uint32_t, Pending> pending_;
   std::map<std::uint32_t, Sequence> sequences_;   // in flight, by request id
-  std::map<std::uint32_t, bool> dropped_;         // cancelled ids whose answers are ignored
+  std::set<std::uint32_t> dropped_;               // cancelled ids whose answers are ignored
   Sequence last_;                                 // the most recent sequence, finished or not
   std::uint32_t waitedId_ = 0;                    // the last sequence whose count a wait returned
   std::uint64_t framesReceived_ = 0;              // numbers the files of `image dir|file`
   std::uint64_t firstFileNumber_ = 0;             // number of a sequence's first `image file` PNG
   int waiters_ = 0;                               // `wait` calls running
   std::optional<TclError> waitError_;             // first error while waiting
-  std::optional<TclError> lastFailure_;          // why the connection ended
+  std::optional<TclError> lastFailure_;           // why the connection ended
   std::string closeReason_;                       // the server's Close reason
   bool layoutPending_ = false;                    // a layout set since open, sent with the next render
   bool deleted_ = false;
 };
+
+// Seconds in a duration, for timings.
+inline double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+// One frame's timing as the Tcl dict the image callback and `timing` give.
+Tcl_Obj* timingDict(const FrameRecord& record);
+
+// True when ::pvr::progress is set: sequences print progress and a timing
+// table on stderr (pvrsh sets it when it runs a script).
+bool progressOn(Tcl_Interp* interp);
 
 }  // namespace pvr::tcl

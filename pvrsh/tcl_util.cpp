@@ -50,6 +50,24 @@ std::vector<double> parseNumbers(const std::string& option, const std::string& t
   return out;
 }
 
+std::vector<double> parseListNumbers(const std::string& option, const std::string& text) {
+  int count = 0;
+  const char** items = nullptr;
+  if (Tcl_SplitList(nullptr, text.c_str(), &count, &items) != TCL_OK)
+    argsError(option.substr(1), option + ": not a Tcl list: '" + text + "'");
+  const std::vector<std::string> elements(items, items + count);
+  Tcl_Free(reinterpret_cast<char*>(items));
+  std::vector<double> out;
+  for (const std::string& element : elements) {
+    // An element with white space is a list of its own (each level is
+    // shorter than the last, so this ends); a single word is read as numbers.
+    const auto inner = element.find_first_of(" \t\r\n") != std::string::npos ? parseListNumbers(option, element)
+                                                                              : parseNumbers(option, element, -1);
+    out.insert(out.end(), inner.begin(), inner.end());
+  }
+  return out;
+}
+
 long parseInteger(const std::string& option, const std::string& text, long lo, long hi) {
   char* end = nullptr;
   errno = 0;
@@ -65,6 +83,25 @@ bool parseBoolean(const std::string& option, const std::string& text) {
   if (Tcl_GetBoolean(nullptr, text.c_str(), &b) != TCL_OK)
     argsError(option.substr(1), option + " needs a boolean (on/off, 1/0), got '" + text + "'");
   return b != 0;
+}
+
+Tcl_Obj* jsonToTcl(const nlohmann::json& value) {
+  if (value.is_object()) {
+    Tcl_Obj* dict = Tcl_NewDictObj();
+    for (const auto& [k, v] : value.items()) Tcl_DictObjPut(nullptr, dict, Tcl_NewStringObj(k.c_str(), -1), jsonToTcl(v));
+    return dict;
+  }
+  if (value.is_array()) {
+    Tcl_Obj* list = Tcl_NewListObj(0, nullptr);
+    for (const auto& v : value) Tcl_ListObjAppendElement(nullptr, list, jsonToTcl(v));
+    return list;
+  }
+  if (value.is_null()) return Tcl_NewObj();
+  if (value.is_boolean()) return Tcl_NewBooleanObj(value.get<bool>());
+  if (value.is_number_integer()) return Tcl_NewWideIntObj(Tcl_WideInt(value.get<std::int64_t>()));
+  if (value.is_number()) return Tcl_NewDoubleObj(value.get<double>());
+  const std::string s = value.get<std::string>();
+  return Tcl_NewStringObj(s.data(), int(s.size()));
 }
 
 }  // namespace pvr::tcl

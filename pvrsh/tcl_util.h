@@ -1,5 +1,6 @@
 // Small helpers shared by the pvr Tcl extension: errors with -errorcode,
-// and the exception type that carries one up to the Tcl boundary.
+// the exception type that carries one up to the Tcl boundary, parsers of
+// option values, and JSON as Tcl values.
 //
 // Inside the extension a failure throws TclError; every Tcl_ObjCmdProc and
 // every event-loop callback catches at its top, so no C++ exception unwinds
@@ -9,6 +10,7 @@
 #include <tcl.h>
 
 #include <initializer_list>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -43,10 +45,18 @@ Tcl_Obj* listOf(const std::vector<std::string>& items);
 // number or the count differs from `count` (any count when count < 0).
 std::vector<double> parseNumbers(const std::string& option, const std::string& text, int count);
 
+// The numbers of a Tcl list whose elements may be lists themselves:
+// "{0 0 0 0 0} {1 1 1 1 1}" gives what "0 0 0 0 0 1 1 1 1 1" gives. An
+// element that is no list splits as parseNumbers splits ("1,2,3").
+std::vector<double> parseListNumbers(const std::string& option, const std::string& text);
+
 // An integer in [lo, hi] or argsError naming `option`.
 long parseInteger(const std::string& option, const std::string& text, long lo, long hi);
 
 // A Tcl boolean (1, 0, on, off, yes, no, true, false) or argsError.
 bool parseBoolean(const std::string& option, const std::string& text);
+
+// A JSON value as Tcl: objects become dicts, arrays lists, null "".
+Tcl_Obj* jsonToTcl(const nlohmann::json& value);
 
 }  // namespace pvr::tcl

@@ -14,10 +14,15 @@
 # `:s notify` (done, cancelled, error) ends a request. Every request goes
 # through ::pvr::gui::view, which keeps at most one in flight.
 #
+# What the server says about the scene comes from `list status` (docs/
+# protocol.md, StatusReply): the camera the view orbits, the data's value
+# range for the transfer-function editor, the points of a loaded preset,
+# and the compositing strategies the layout window offers.
+#
 # -datadir names the daemon's data directory when it is readable here (pvrd
-# on this machine): the dataset's JSON sidecar then gives the scalar range
-# and histogram for the transfer-function editor. Without it the editor
-# shows a plain ramp over the range typed in its fields.
+# on this machine): the dataset's JSON sidecar then gives the histogram
+# behind the transfer-function editor. Without it the editor shows a plain
+# ramp.
 
 package require Tk 8.6
 
@@ -49,6 +54,9 @@ namespace eval ::pvr::gui {
     variable lastLatency 0
     # A transfer-function change waits here until the request in flight ends.
     variable tfPending 0
+    # A new dataset: the editor takes the server's value range before the
+    # next request.
+    variable rangePending 0
     # Whether the session is open (kept here: `list status` asks the server).
     variable connected 0
     # Errors shown on the status line so far.
@@ -96,7 +104,7 @@ proc ::pvr::gui::main {args} {
     $session image window $::pvr::gui::image
     $session image callback ::pvr::gui::onFrame
     $session notify ::pvr::gui::onNotify
-    ::pvr::gui::view::attach .view.image [list ::pvr::gui::send]
+    ::pvr::gui::view::attach .view.image [list ::pvr::gui::send] ::pvr::gui::readScene
     if {$connect} {
         after idle ::pvr::gui::connect
     }
@@ -172,7 +180,8 @@ proc ::pvr::gui::buildMain {} {
     ttk::entry $f.range.lo -width 9 -textvariable ::pvr::gui::opt(tflo)
     ttk::entry $f.range.hi -width 9 -textvariable ::pvr::gui::opt(tfhi)
     ttk::button $f.range.set -text "Set" -command ::pvr::gui::applyTfRange
-    pack $f.range.l $f.range.lo $f.range.hi $f.range.set -side left -padx 2
+    ttk::button $f.range.preset -text "Preset\u2026" -command ::pvr::gui::choosePreset
+    pack $f.range.l $f.range.lo $f.range.hi $f.range.set $f.range.preset -side left -padx 2
     pack $f.editor -fill both -expand 1
     pack $f.range -anchor w -pady 2
 
@@ -296,10 +305,10 @@ proc ::pvr::gui::disconnect {} {
 }
 
 # ::pvr::gui::sidecar --
-#   Scalar range and histogram of dataset `name` from its JSON sidecar under
-#   -datadir: a dict with lo, hi and, when present, edges and fractions;
-#   empty when unknown. The sidecar's layout is fixed (see the data README),
-#   so a few patterns read it without a JSON package.
+#   The histogram of dataset `name` from its JSON sidecar under -datadir: a
+#   dict with edges and fractions, empty when unknown. The sidecar's layout
+#   is fixed (see the data README), so two patterns read it without a JSON
+#   package.
 proc ::pvr::gui::sidecar {name} {
     variable opt
     if {$opt(datadir) eq "" || [file extension $name] ne ".json"} {
@@ -310,11 +319,6 @@ proc ::pvr::gui::sidecar {name} {
         return {}
     }
     set info {}
-    set num {-?[0-9.]+(?:[eE][-+]?[0-9]+)?}
-    if {[regexp "\"min\":\\s*($num)" $text -> lo] && [regexp "\"max\":\\s*($num)" $text -> hi] && $lo < $hi} {
-        dict set info lo $lo
-        dict set info hi $hi
-    }
     if {[regexp {"edges":\s*\[([^\]]*)\]} $text -> edges] && [regexp {"fractions":\s*\[([^\]]*)\]} $text -> fractions]} {
         dict set info edges [string map {, " "} $edges]
         dict set info fractions [string map {, " "} $fractions]
@@ -323,32 +327,71 @@ proc ::pvr::gui::sidecar {name} {
 }
 
 # ::pvr::gui::loadDataset --
-#   Selects dataset `name`, fits the transfer function to its range when
-#   known, and renders a frame.
+#   Selects dataset `name` and renders a frame. Before that frame the view
+#   takes the server's camera for it and the editor its value range
+#   (readScene), and the editor's points go out in that range.
 proc ::pvr::gui::loadDataset {name} {
     variable session
     variable opt
+    variable tfPending
+    variable rangePending
     set opt(dataset) $name
-    set editor .ctl.tf.editor
     set info [sidecar $name]
-    if {[dict exists $info lo]} {
-        set opt(tflo) [dict get $info lo]
-        set opt(tfhi) [dict get $info hi]
-        ::pvr::gui::tfeditor::range $editor $opt(tflo) $opt(tfhi)
-    }
     if {[dict exists $info edges]} {
-        ::pvr::gui::tfeditor::histogram $editor [dict get $info edges] [dict get $info fractions]
+        ::pvr::gui::tfeditor::histogram .ctl.tf.editor [dict get $info edges] [dict get $info fractions]
     } else {
-        ::pvr::gui::tfeditor::histogram $editor {} {}
+        ::pvr::gui::tfeditor::histogram .ctl.tf.editor {} {}
     }
     lassign [split $opt(imagesz) x] w h
-    if {[catch {$session set -dataset $name -imagesz $w,$h -tf [::pvr::gui::tfeditor::points $editor]} message]} {
+    if {[catch {$session set -dataset $name -imagesz $w,$h} message]} {
         status "dataset $name: $message" error
         return
     }
     ::pvr::gui::stat::clear .stat.c
     status "dataset $name"
+    set rangePending 1
+    set tfPending 1
+    ::pvr::gui::view::sceneChanged
     ::pvr::gui::view::request
+}
+
+# ::pvr::gui::serverStatus --
+#   The server's status entries (`list status`, remote): a dict, empty
+#   while a request is in flight or when the session is not open.
+proc ::pvr::gui::serverStatus {} {
+    variable session
+    if {[catch {dict get [$session list status] remote} remote]} {
+        status "status: $remote" error
+        return {}
+    }
+    return $remote
+}
+
+# ::pvr::gui::readScene --
+#   The view's camera source, asked before a request when the dataset has
+#   changed: returns the server's camera {eye look_at up} ({} when it has
+#   none yet), and fits the editor to the data's value range for a new
+#   dataset.
+proc ::pvr::gui::readScene {} {
+    variable opt
+    variable rangePending
+    set remote [serverStatus]
+    if {$rangePending && [dict exists $remote value_range]} {
+        lassign [dict get $remote value_range] lo hi
+        if {$lo < $hi} {
+            set opt(tflo) $lo
+            set opt(tfhi) $hi
+            ::pvr::gui::tfeditor::range .ctl.tf.editor $lo $hi
+        }
+        set rangePending 0
+    }
+    set camera {}
+    foreach key {camera_eye camera_look_at camera_up} {
+        if {[dict exists $remote $key]} {
+            lappend camera [dict get $remote $key]
+        }
+    }
+    return [expr {[llength $camera] == 3 ? $camera : {}}]
 }
 
 proc ::pvr::gui::applyImageSize {} {
@@ -374,6 +417,67 @@ proc ::pvr::gui::applyTfRange {} {
         return
     }
     tfChanged [::pvr::gui::tfeditor::points .ctl.tf.editor]
+}
+
+proc ::pvr::gui::choosePreset {} {
+    set file [tk_getOpenFile -title "ParaView transfer-function preset" \
+                  -filetypes {{{ParaView presets} {.json}} {{All files} *}}]
+    if {$file ne ""} {
+        loadPreset $file
+    }
+}
+
+# ::pvr::gui::loadPreset --
+#   Sends the ParaView preset `file` (`:s set -tfpreset`); the server reads
+#   it, and its points, as `list status` reports them, go into the editor,
+#   which renders a frame. Results: 1 when the editor holds the preset.
+proc ::pvr::gui::loadPreset {file} {
+    variable session
+    variable opt
+    variable connected
+    if {!$connected} {
+        status "preset: not connected" error
+        return 0
+    }
+    if {$::pvr::gui::view::busy} {
+        status "preset: a request is in flight; load the preset when it ends" error
+        return 0
+    }
+    set errors $::pvr::gui::errors
+    if {[catch {$session set -tfpreset $file} message]} {
+        status "preset: $message" error
+        return 0
+    }
+    set remote [serverStatus]
+    # A preset the server refused was reported on the status line meanwhile.
+    if {$::pvr::gui::errors > $errors} {
+        return 0
+    }
+    if {![dict exists $remote transfer_function]} {
+        status "preset $file: the server reports no transfer function" error
+        return 0
+    }
+    set points [dict get $remote transfer_function]
+    status "preset [file tail $file]"
+    if {[catch {
+        # The editor's range covers the data and every point of the preset.
+        set lo [lindex $points 0]
+        set hi [lindex $points end-4]
+        if {[dict exists $remote value_range]} {
+            lassign [dict get $remote value_range] vlo vhi
+            set lo [expr {min($lo, $vlo)}]
+            set hi [expr {max($hi, $vhi)}]
+        }
+        ::pvr::gui::tfeditor::range .ctl.tf.editor $lo $hi
+        # Setting the points notifies tfChanged, which renders with them.
+        ::pvr::gui::tfeditor::points .ctl.tf.editor $points
+    } message]} {
+        status "preset $file: $message" error
+        return 0
+    }
+    set opt(tflo) $lo
+    set opt(tfhi) $hi
+    return 1
 }
 
 # ::pvr::gui::tfChanged --

@@ -5,9 +5,12 @@
 # one group share the scanlines of a frame, groups take different frames
 # (`:s set -cluster r,RANKS -group 0,0,1,1`). Compositing is done by the
 # rendering ranks themselves, or by separate compositing clusters
-# (`-cluster c -group 0,0`). The window also asks the server what a layout
-# costs: dataset memory per cluster and the estimated compositing latency
-# (`:s performance memory cluster`, `:s performance comp cluster latency`).
+# (`-cluster c -group 0,0`). The strategy and decomposition boxes offer
+# what the server reports (`list status`: strategies, decompositions) and
+# show what is in force (strategy, decomposition). The window also asks the
+# server what a layout costs: dataset memory per cluster and the estimated
+# compositing latency (`:s performance memory cluster`,
+# `:s performance comp cluster latency`).
 
 namespace eval ::pvr::gui::layout {
     # The form's variables, bound to the widgets.
@@ -17,13 +20,13 @@ namespace eval ::pvr::gui::layout {
         renderGroups 0
         composite self
         compositeGroups 0
-        strategy binary-swap
-        decomposition kd
+        strategy ""
+        decomposition ""
     }
-    # Strategy and decomposition as last sent (the server's defaults at
-    # first): they are sent only when the form differs.
-    variable sent
-    array set sent {strategy binary-swap decomposition kd}
+    # Strategy and decomposition in force, as the server last reported them:
+    # the form's are sent only when they differ.
+    variable inForce
+    array set inForce {strategy "" decomposition ""}
 }
 
 # ::pvr::gui::layout::show --
@@ -52,17 +55,15 @@ proc ::pvr::gui::layout::show {session} {
     grid $f.help - -sticky w -pady 2
 
     set c [ttk::labelframe $w.comp -text "Compositing" -padding 6]
-    ttk::radiobutton $c.self -text "Rendering ranks composite (binary swap among them)" \
+    ttk::radiobutton $c.self -text "Rendering ranks composite (with the strategy below)" \
         -variable ::pvr::gui::layout::form(composite) -value self
     ttk::radiobutton $c.sep -text "Separate compositing clusters, groups:" \
         -variable ::pvr::gui::layout::form(composite) -value separate
     ttk::entry $c.ge -width 10 -textvariable ::pvr::gui::layout::form(compositeGroups)
     ttk::label $c.sl -text "Strategy"
-    ttk::combobox $c.sc -state readonly -width 14 -textvariable ::pvr::gui::layout::form(strategy) \
-        -values {binary-swap direct-send tree radix-k pipeline}
+    ttk::combobox $c.sc -state readonly -width 14 -textvariable ::pvr::gui::layout::form(strategy)
     ttk::label $c.dl -text "Decomposition"
-    ttk::combobox $c.dc -state readonly -width 14 -textvariable ::pvr::gui::layout::form(decomposition) \
-        -values {kd balanced}
+    ttk::combobox $c.dc -state readonly -width 14 -textvariable ::pvr::gui::layout::form(decomposition)
     grid $c.self - -sticky w
     grid $c.sep $c.ge -sticky w
     grid $c.sl $c.sc -sticky w -pady 2
@@ -103,9 +104,11 @@ proc ::pvr::gui::layout::report {text} {
 }
 
 # ::pvr::gui::layout::refresh --
-#   Shows the layout in force (`:s list status`), and fills the form from it.
+#   Shows the layout in force (`:s list status`), fills the form from it,
+#   and offers the server's strategies and decompositions.
 proc ::pvr::gui::layout::refresh {session} {
     variable form
+    variable inForce
     if {[catch {$session list status} status]} {
         report "status: $status"
         return
@@ -132,10 +135,15 @@ proc ::pvr::gui::layout::refresh {session} {
         set form(composite) separate
         set form(compositeGroups) [join $compositeGroups ,]
     }
-    set options [dict get $status options]
-    foreach {key option} {strategy -strategy decomposition -decomposition} {
-        if {[dict exists $options $option]} {
-            set form($key) [dict get $options $option]
+    set remote [dict get $status remote]
+    foreach {key names box} {strategy strategies .layout.comp.sc decomposition decompositions .layout.comp.dc} {
+        if {[dict exists $remote $names]} {
+            $box configure -values [dict get $remote $names]
+        }
+        if {[dict exists $remote $key]} {
+            set inForce($key) [dict get $remote $key]
+            set form($key) $inForce($key)
+            lappend lines "  $key $inForce($key)"
         }
     }
     report [join $lines \n]
@@ -145,12 +153,11 @@ proc ::pvr::gui::layout::refresh {session} {
 #   Sends the form as -cluster/-group, -strategy and -decomposition settings.
 proc ::pvr::gui::layout::apply {session} {
     variable form
-    variable sent
+    variable inForce
     set settings [list -cluster r,$form(renderRanks) -group $form(renderGroups)]
     foreach key {strategy decomposition} {
-        if {$form($key) ne $sent($key)} {
+        if {$form($key) ne "" && $form($key) ne $inForce($key)} {
             lappend settings -$key $form($key)
-            set sent($key) $form($key)
         }
     }
     if {[catch {

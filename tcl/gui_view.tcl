@@ -1,24 +1,34 @@
 # gui_view.tcl -- the camera of the PVR GUI: azimuth/elevation from mouse
 # drags and buttons, turned into render requests that never pile up.
 #
-# The GUI does not know the volume's bounds, so it does not place the eye
-# itself. It orbits the server's automatic camera instead (docs/scene.md:
-# looking at the centre of the domain from -y, turned 30 degrees in azimuth
-# about +z, raised 20 degrees, up +z): any orbit position is one rotation of
-# that camera about its look-at point (Euler's rotation theorem), and
-# `:s render rotate AXIS K,K:N` renders exactly one frame of the base camera
-# rotated by K/N of a turn about AXIS. The rotation that takes the base view
-# to azimuth A, elevation E is R = F(A,E) * F(A0,E0)^T, where F is the
-# orthonormal frame {view direction, right, up} of an orbit camera.
+# The GUI does not place the eye itself. It orbits the camera the server
+# reports for the dataset (`list status`: camera_eye, camera_look_at,
+# camera_up; the automatic camera unless a scene says otherwise). The
+# orbit's vertical axis is that camera's up vector; the elevation is the
+# eye's angle above the plane across it, the azimuth the turn about it
+# from the reported eye (0 there). Any orbit position is one rotation of
+# the reported camera about its look-at point (Euler's rotation theorem),
+# and `:s render rotate AXIS K,K:N` renders exactly one frame of the scene's
+# camera with its eye and up turned by K/N of a turn about AXIS through the
+# look-at point (docs/protocol.md, RenderRotation). The rotation that takes
+# the reported view to azimuth A, elevation E is R = F(A,E) * F(0,E0)^T,
+# where F is the orthonormal frame {view direction, right, up} of an orbit
+# camera and E0 the reported camera's elevation.
 #
 # Coalescing: at most one request is in flight. A drag that moves while a
 # frame is being rendered only records the newest angles; when the frame
 # arrives (or fails) the newest angles are sent, once.
 
 namespace eval ::pvr::gui::view {
-    # The automatic camera's angles (degrees), docs/scene.md "camera".
-    variable baseAzimuth 30.0
-    variable baseElevation 20.0
+    # The reported camera as the orbit's basis: unit vectors up (the
+    # vertical axis), ahead (from the look-at point towards the eye, across
+    # the vertical) and side (up x ahead, towards positive azimuth), and the
+    # eye's elevation in degrees. Empty until the server has reported one.
+    variable base {}
+    variable baseElevation 0.0
+    # The command that returns the server's camera as {eye look_at up}
+    # ({} when it has none); asked before a request when base is empty.
+    variable cameraSource {}
     # Steps per turn in the rotate request: 0.01 degree resolution.
     variable stepsPerTurn 36000
     # Degrees per pixel of drag.
@@ -33,34 +43,79 @@ proc ::pvr::gui::view::cross {a b} {
     return [list [expr {$ay * $bz - $az * $by}] [expr {$az * $bx - $ax * $bz}] [expr {$ax * $by - $ay * $bx}]]
 }
 
+proc ::pvr::gui::view::dot {a b} {
+    lassign $a ax ay az
+    lassign $b bx by bz
+    return [expr {$ax * $bx + $ay * $by + $az * $bz}]
+}
+
+# a + s * b
+proc ::pvr::gui::view::addScaled {a s b} {
+    return [lmap x $a y $b {expr {$x + $s * $y}}]
+}
+
 proc ::pvr::gui::view::normalize {v} {
     lassign $v x y z
     set n [expr {sqrt($x * $x + $y * $y + $z * $z)}]
     return [list [expr {$x / $n}] [expr {$y / $n}] [expr {$z / $n}]]
 }
 
+# ::pvr::gui::view::setBase --
+#   Makes the camera at `eye` looking at `lookAt` with `up` the orbit's
+#   base, at azimuth 0 and its own elevation. Results: 1, or 0 (and no
+#   base) when the three do not make a camera.
+proc ::pvr::gui::view::setBase {eye lookAt up} {
+    variable base
+    variable baseElevation
+    variable azimuth
+    variable elevation
+    set base {}
+    if {[llength $eye] != 3 || [llength $lookAt] != 3 || [llength $up] != 3} {
+        return 0
+    }
+    set toEye [addScaled $eye -1 $lookAt]
+    if {[dot $toEye $toEye] == 0 || [dot $up $up] == 0} {
+        return 0
+    }
+    set v [normalize $up]
+    set d [normalize $toEye]
+    set sinE [dot $d $v]
+    set across [addScaled $d [expr {-$sinE}] $v]
+    if {[dot $across $across] < 1e-12} {
+        # Looking along the up vector: a camera refuses it (docs/scene.md).
+        return 0
+    }
+    set ahead [normalize $across]
+    set base [list $v $ahead [cross $v $ahead]]
+    set baseElevation [expr {asin(max(-1.0, min(1.0, $sinE))) * 180.0 / acos(-1)}]
+    set azimuth 0.0
+    set elevation $baseElevation
+    return 1
+}
+
 # ::pvr::gui::view::frame --
 #   The orbit camera's frame at azimuth `az`, elevation `el` (degrees): the
 #   direction from the look-at point to the eye, the right vector and the
-#   up vector, as a list of three 3-lists.
+#   up vector, as a list of three 3-lists. Needs a base.
 proc ::pvr::gui::view::frame {az el} {
+    variable base
+    lassign $base up ahead side
     set a [expr {$az * acos(-1) / 180.0}]
     set e [expr {$el * acos(-1) / 180.0}]
-    # Azimuth 0 looks from -y; positive azimuth turns the eye towards +x.
-    set d [list [expr {cos($e) * sin($a)}] [expr {-cos($e) * cos($a)}] [expr {sin($e)}]]
-    set r [normalize [cross {0 0 1} $d]]
+    # Positive azimuth turns the eye from `ahead` towards `side`.
+    set d [lmap h $ahead s $side v $up {expr {cos($e) * (cos($a) * $h + sin($a) * $s) + sin($e) * $v}}]
+    set r [normalize [cross $up $d]]
     set u [cross $d $r]
     return [list $d $r $u]
 }
 
 # ::pvr::gui::view::rotation --
-#   The rotation taking the automatic camera to (az, el), as {axis degrees}
+#   The rotation taking the reported camera to (az, el), as {axis degrees}
 #   with the angle in [0, 180]; {{0 0 1} 0.0} for none.
 proc ::pvr::gui::view::rotation {az el} {
-    variable baseAzimuth
     variable baseElevation
     set F [frame $az $el]
-    set F0 [frame $baseAzimuth $baseElevation]
+    set F0 [frame 0.0 $baseElevation]
     # R[i][j] = sum over the frame vectors k of F[k][i] * F0[k][j].
     for {set i 0} {$i < 3} {incr i} {
         for {set j 0} {$j < 3} {incr j} {
@@ -99,9 +154,14 @@ proc ::pvr::gui::view::rotation {az el} {
 
 # ::pvr::gui::view::rotateArgs --
 #   The arguments of `:s render rotate` for one frame at (az, el), or {}
-#   when the view is the automatic camera's own (then `render frame`).
+#   when the view is the reported camera's own or no camera is known yet
+#   (then `render frame`).
 proc ::pvr::gui::view::rotateArgs {az el} {
     variable stepsPerTurn
+    variable base
+    if {$base eq {}} {
+        return {}
+    }
     lassign [rotation $az $el] axis degrees
     set k [expr {int(round($degrees / 360.0 * $stepsPerTurn))}]
     if {$k == 0} {
@@ -116,8 +176,8 @@ proc ::pvr::gui::view::rotateArgs {az el} {
 namespace eval ::pvr::gui::view {
     # azimuth, elevation: the view wanted; busy: a request is in flight;
     # dirty: the view changed while busy; drag: last pointer position.
-    variable azimuth 30.0
-    variable elevation 20.0
+    variable azimuth 0.0
+    variable elevation 0.0
     variable busy 0
     variable dirty 0
     variable drag {}
@@ -130,10 +190,13 @@ namespace eval ::pvr::gui::view {
 }
 
 # ::pvr::gui::view::attach --
-#   Binds drags on widget `w` to the view; `sender` sends one request.
-proc ::pvr::gui::view::attach {w command} {
+#   Binds drags on widget `w` to the view; `command` sends one request,
+#   `camera` returns the server's camera (see cameraSource).
+proc ::pvr::gui::view::attach {w command camera} {
     variable sender
+    variable cameraSource
     set sender $command
+    set cameraSource $camera
     bind $w <ButtonPress-1> [list ::pvr::gui::view::dragStart %x %y]
     bind $w <B1-Motion> [list ::pvr::gui::view::dragMotion %x %y]
     bind $w <ButtonRelease-1> [list ::pvr::gui::view::dragEnd %x %y]
@@ -180,15 +243,22 @@ proc ::pvr::gui::view::turn {dAzimuth dElevation} {
 }
 
 # ::pvr::gui::view::reset --
-#   Back to the automatic camera, and a frame.
+#   Back to the reported camera, and a frame.
 proc ::pvr::gui::view::reset {} {
     variable azimuth
     variable elevation
-    variable baseAzimuth
     variable baseElevation
-    set azimuth $baseAzimuth
+    set azimuth 0.0
     set elevation $baseElevation
     request
+}
+
+# ::pvr::gui::view::sceneChanged --
+#   The server's camera may have changed (another dataset): it is asked
+#   again before the next request, and the view starts from it.
+proc ::pvr::gui::view::sceneChanged {} {
+    variable base
+    set base {}
 }
 
 # ::pvr::gui::view::request --
@@ -198,6 +268,8 @@ proc ::pvr::gui::view::request {} {
     variable busy
     variable dirty
     variable sender
+    variable base
+    variable cameraSource
     variable azimuth
     variable elevation
     variable sent
@@ -210,10 +282,18 @@ proc ::pvr::gui::view::request {} {
         return
     }
     set dirty 0
-    set rotate [rotateArgs $azimuth $elevation]
-    set words [expr {$rotate eq {} ? {frame} : [linsert $rotate 0 rotate]}]
     set busy 1
-    if {[catch {uplevel #0 [concat $sender $words]} message options]} {
+    if {[catch {
+        if {$base eq {} && $cameraSource ne {}} {
+            set camera [uplevel #0 $cameraSource]
+            if {[llength $camera] == 3} {
+                setBase {*}$camera
+            }
+        }
+        set rotate [rotateArgs $azimuth $elevation]
+        set words [expr {$rotate eq {} ? {frame} : [linsert $rotate 0 rotate]}]
+        uplevel #0 [concat $sender $words]
+    } message options]} {
         set busy 0
         return -options $options $message
     }

@@ -2,7 +2,9 @@
 # temporary data directory, and pvrd started on an ephemeral loopback port.
 #
 # The environment (set by tests/pvrsh/CMakeLists.txt) names the programs:
-# PVRD, PVR_NODE (pvr-node), PVR_RENDER, PVR_TEST_TMP.
+# PVRD, PVR_NODE (pvr-node), PVRSH, PVR_RENDER, and PVR_TEST_TMP. A test file
+# that needs a program asks ::pvrtest::program for it: a file registered
+# without its programs fails instead of skipping its tests.
 
 package require tcltest 2
 namespace import ::tcltest::*
@@ -13,6 +15,18 @@ namespace eval ::pvrtest {
     variable pvrd ""        ;# channel of the running pvrd
     variable pvrdPid 0
     variable port 0
+}
+
+# ::pvrtest::program VAR: the program the environment variable VAR names;
+# an error when it is not set or not executable.
+proc ::pvrtest::program {var} {
+    if {![info exists ::env($var)]} {
+        error "this test needs the program named by \$$var, which is not set (tests/pvrsh/CMakeLists.txt sets it)"
+    }
+    if {![file executable $::env($var)]} {
+        error "\$$var names $::env($var), which is not an executable (build it first)"
+    }
+    return $::env($var)
 }
 
 # ::pvrtest::makeData DIR: writes ball/ball.raw + ball.json, a 32^3 uint8
@@ -48,7 +62,7 @@ proc ::pvrtest::startPvrd {args} {
     variable pvrdPid
     variable port
     set data [makeData [file join $tmp data]]
-    set cmd [list $::env(PVRD) --listen 127.0.0.1:0 --data-dir $data --node $::env(PVR_NODE) {*}$args]
+    set cmd [list [program PVRD] --listen 127.0.0.1:0 --data-dir $data --node [program PVR_NODE] {*}$args]
     set pvrd [open |[concat $cmd [list 2>> [file join $tmp pvrd.log]]] r]
     set pvrdPid [pid $pvrd]
     gets $pvrd line
@@ -76,6 +90,38 @@ proc ::pvrtest::killPvrd {} {
     catch {close $pvrd}
     set pvrd ""
     set pvrdPid 0
+}
+
+# ::pvrtest::near GOT WANT ?TOLERANCE?: 1 when the number lists GOT and WANT
+# have the same length and agree element by element within TOLERANCE.
+proc ::pvrtest::near {got want {tolerance 1e-9}} {
+    if {[llength $got] != [llength $want]} {
+        return 0
+    }
+    foreach a $got b $want {
+        if {![string is double -strict $a] || abs($a - $b) > $tolerance} {
+            return 0
+        }
+    }
+    return 1
+}
+
+# ::pvrtest::maxDiff A B: the largest difference of any 8-bit channel
+# between the Tk photo images A and B of one size (needs Tk).
+proc ::pvrtest::maxDiff {a b} {
+    if {[image width $a] != [image width $b] || [image height $a] != [image height $b]} {
+        error "images $a and $b differ in size"
+    }
+    set worst 0
+    for {set y 0} {$y < [image height $a]} {incr y} {
+        for {set x 0} {$x < [image width $a]} {incr x} {
+            foreach p [$a get $x $y] q [$b get $x $y] {
+                set d [expr {abs($p - $q)}]
+                if {$d > $worst} { set worst $d }
+            }
+        }
+    }
+    return $worst
 }
 
 # ::pvrtest::errorcode SCRIPT: the -errorcode of SCRIPT's error, or "ok".

@@ -5,17 +5,23 @@
 # Starts pvrd on an ephemeral loopback port with a 32^3 volume that is not
 # symmetric about any axis (an off-centre block and a ball), opens the GUI
 # (tcl/gui.tcl) on it, and checks, by the photo's pixels:
-#   1. the first frame arrives after connecting;
+#   1. the first frame arrives after connecting; the view starts from the
+#      camera the server reports, the editor spans the data's value range;
 #   2. a drag on the image turns the view, coalesces its motion events into
 #      fewer requests, and changes the image;
-#   3. a press of the "turn right" button turns it by 15 degrees, another frame;
+#   3. a press of the "turn right" button turns it by 15 degrees, another
+#      frame, equal to a second session's frame of the same camera set
+#      explicitly (eye and up turned about the look-at point);
 #   4. dragging a transfer-function point renders again, with other pixels;
-#   5. a rotation sequence fills the progress bar and the performance graph;
-#   6. the cluster and group window shows the layout, asks the server for
-#      memory per cluster, and applies the form.
+#   5. a ParaView preset loaded through the GUI: the editor holds the points
+#      the server read, and a frame renders with them;
+#   6. a rotation sequence fills the progress bar and the performance graph;
+#   7. the cluster and group window shows the layout, asks the server for
+#      memory per cluster, applies the form, and its Strategy box offers
+#      exactly the server's strategies, each of which renders without error.
 # Writes DIR/gui_frame.png (the photo) and DIR/gui_screenshot.png (the whole
 # screen, when ImageMagick's import is installed). Exits 0 when all pass, 1
-# otherwise; gives up after 50 s.
+# otherwise; gives up after 80 s.
 
 package require Tk
 
@@ -58,8 +64,8 @@ proc finish {} {
     exit [expr {$::failures == 0 ? 0 : 1}]
 }
 
-after 50000 {
-    puts "FAIL timeout: the GUI test did not finish in 50 s"
+after 80000 {
+    puts "FAIL timeout: the GUI test did not finish in 80 s"
     incr ::failures
     finish
 }
@@ -111,7 +117,7 @@ close $f
 set env(OMPI_ALLOW_RUN_AS_ROOT) 1
 set env(OMPI_ALLOW_RUN_AS_ROOT_CONFIRM) 1
 # `timeout` ends pvrd even when this script is killed before finish runs.
-set pvrdChan [open |[list timeout --signal=TERM 80 $arg(-pvrd) --listen 127.0.0.1:0 --data-dir $data --node $arg(-node) --max-ranks 2 2>@stderr] r]
+set pvrdChan [open |[list timeout --signal=TERM 110 $arg(-pvrd) --listen 127.0.0.1:0 --data-dir $data --node $arg(-node) --max-ranks 2 2>@stderr] r]
 fconfigure $pvrdChan -blocking 0 -buffering line
 set port ""
 proc readPvrd {} {
@@ -172,10 +178,19 @@ check "first frame: 128x128 in the photo" \
 set lit0 [lit]
 check "first frame: the volume is visible (lit pixels)" {$lit0 > 5} "lit $lit0"
 set frame0 [pixels]
+# The server's report of the scene (docs/protocol.md, StatusReply).
+set remote [dict get [$::pvr::gui::session list status] remote]
+check "first frame: the view starts at the server's camera" \
+    {$::pvr::gui::view::base ne {} && $::pvr::gui::view::azimuth == 0 &&
+     $::pvr::gui::view::elevation == $::pvr::gui::view::baseElevation} "camera [dict filter $remote key camera_*]"
+check "first frame: the editor spans the server's value range" \
+    {[::pvr::gui::tfeditor::range .ctl.tf.editor] == [lmap v [dict get $remote value_range] {expr {double($v)}}]} \
+    "range [::pvr::gui::tfeditor::range .ctl.tf.editor], value_range [dict get $remote value_range]"
 
 # ---- Step 3: a drag on the image ----
 set sentBefore $::pvr::gui::view::sent
 set az0 $::pvr::gui::view::azimuth
+set el0 $::pvr::gui::view::elevation
 set img .view.image
 event generate $img <ButtonPress-1> -x 40 -y 64 -button 1
 for {set i 1} {$i <= 12} {incr i} {
@@ -184,8 +199,8 @@ for {set i 1} {$i <= 12} {incr i} {
 event generate $img <ButtonRelease-1> -x 100 -y 76 -button 1 -state 0x100
 check "drag: the azimuth turned 30 degrees" \
     {abs(fmod($az0 - $::pvr::gui::view::azimuth + 360, 360) - 30) < 1e-6} "azimuth $::pvr::gui::view::azimuth"
-check "drag: the elevation rose 6 degrees (dragging down)" {abs($::pvr::gui::view::elevation - 26) < 1e-6} \
-    "elevation $::pvr::gui::view::elevation"
+check "drag: the elevation rose 6 degrees (dragging down)" {abs($::pvr::gui::view::elevation - $el0 - 6) < 1e-6} \
+    "elevation $::pvr::gui::view::elevation from $el0"
 waitFor {[idle]} 20
 set requests [expr {$::pvr::gui::view::sent - $sentBefore}]
 check "drag: 12 motion events coalesced into fewer requests" {$requests >= 1 && $requests < 12} "requests $requests"
@@ -206,7 +221,49 @@ check "button: the azimuth turned 15 degrees" \
 set frame2 [pixels]
 check "button: a new frame with other pixels" {$frame2 ne $frame1}
 
-# ---- Step 5: drag a transfer-function point ----
+# ---- Step 5: the same view from a camera set explicitly ----
+# The GUI's view is now the reported camera orbited: its eye raised by
+# E - E0 towards the up vector and turned by the azimuth A about it,
+# around the look-at point, the up vector kept (RenderRotation turns eye
+# and up; the camera keeps the up's part across the view). A second
+# session renders that camera, set explicitly, with the GUI's transfer
+# function: the frames agree within 2/255 per channel.
+proc turned {v axis degrees} {
+    # Rodrigues: v turned by `degrees` about `axis` (right-handed).
+    set a [expr {$degrees * acos(-1) / 180.0}]
+    set k [::pvr::gui::view::normalize $axis]
+    set kxv [::pvr::gui::view::cross $k $v]
+    set kv [::pvr::gui::view::dot $k $v]
+    return [lmap x $v c $kxv kk $k {expr {$x * cos($a) + $c * sin($a) + $kk * $kv * (1 - cos($a))}}]
+}
+set lookAt [dict get $remote camera_look_at]
+set up [dict get $remote camera_up]
+set toEye [::pvr::gui::view::addScaled [dict get $remote camera_eye] -1 $lookAt]
+set raised [turned $toEye [::pvr::gui::view::cross $toEye $up] \
+                [expr {$::pvr::gui::view::elevation - $::pvr::gui::view::baseElevation}]]
+set eye [::pvr::gui::view::addScaled $lookAt 1 [turned $raised $up $::pvr::gui::view::azimuth]]
+set refPhoto [image create photo]
+pvr_session :ref
+:ref image window $refPhoto
+:ref open 127.0.0.1:$port -ranks 1
+:ref set -dataset $::pvr::gui::opt(dataset) -imagesz 128,128 \
+    -tf [::pvr::gui::tfeditor::points .ctl.tf.editor] \
+    -eye [join $eye ,] -lookat [join $lookAt ,] -up [join $up ,] -fov [dict get $remote camera_fov_y_deg]
+:ref render frame
+:ref wait -timeout 20
+set worst 0
+for {set y 0} {$y < 128} {incr y} {
+    for {set x 0} {$x < 128} {incr x} {
+        foreach p [$photo get $x $y] q [$refPhoto get $x $y] {
+            set worst [expr {max($worst, abs($p - $q))}]
+        }
+    }
+}
+rename :ref {}
+check "button: the frame equals the reported camera turned, rendered by another session" {$worst <= 2} \
+    "differs by $worst/255"
+
+# ---- Step 6: drag a transfer-function point ----
 set editor .ctl.tf.editor
 set sentBefore $::pvr::gui::view::sent
 set points [::pvr::gui::tfeditor::normalized $editor]
@@ -221,7 +278,27 @@ set opacity [lindex [::pvr::gui::tfeditor::normalized $editor] end 4]
 check "tf: the last point's opacity went down" {$opacity < [lindex $points end 4]} "opacity $opacity"
 check "tf: the change rendered a new frame" {$::pvr::gui::view::sent > $sentBefore && [pixels] ne $frame2}
 
-# ---- Step 6: a rotation sequence ----
+# ---- Step 7: a ParaView preset through the GUI ----
+set preset [file join $arg(-out) preset.json]
+set f [open $preset w]
+puts $f {[{"Name": "test", "RGBPoints": [0, 0, 0, 0, 120, 1, 0.5, 0, 200, 1, 1, 1],
+          "Points": [0, 0, 0.5, 0, 100, 0.1, 0.5, 0, 200, 0.8, 0.5, 0]}]}
+close $f
+set sentBefore $::pvr::gui::view::sent
+set frame3 [pixels]
+set loaded [::pvr::gui::loadPreset $preset]
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+set serverPoints [dict get [$::pvr::gui::session list status] remote transfer_function]
+set editorPoints [::pvr::gui::tfeditor::points $editor]
+set same [expr {[llength $serverPoints] == [llength $editorPoints]}]
+foreach a $serverPoints b $editorPoints {
+    if {abs($a - $b) > 1e-6} { set same 0 }
+}
+check "preset: the editor holds the points the server read" {$loaded && $same && [llength $editorPoints] >= 15} \
+    "editor $editorPoints, server $serverPoints"
+check "preset: a frame renders with them" {$::pvr::gui::view::sent > $sentBefore && [pixels] ne $frame3}
+
+# ---- Step 8: a rotation sequence ----
 set ::pvr::gui::opt(axis) 0,0,1
 set ::pvr::gui::opt(range) 0,5:12
 set statFrames [llength [::pvr::gui::stat::frames .stat.c]]
@@ -241,7 +318,7 @@ foreach k {dist rend comp comm send} {
 }
 check "graph: the frame's timing has the five phases" {$phases == 5} $timing
 
-# ---- Step 7: the cluster and group window ----
+# ---- Step 9: the cluster and group window ----
 ::pvr::gui::layout::show $::pvr::gui::session
 update
 check "layout: the window shows the layout in force" \
@@ -255,7 +332,24 @@ waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
 check "layout: apply sets the clusters and renders" \
     {[string match "frame * in * ms*" $::pvr::gui::statusText]} $::pvr::gui::statusText
 
-# ---- Step 8: artifacts ----
+set box .layout.comp.sc
+set offered [$box cget -values]
+set strategies [dict get [$::pvr::gui::session list status] remote strategies]
+check "strategy box: offers exactly the server's strategies" {[llength $offered] > 0 && $offered eq $strategies} \
+    "box {$offered}, server {$strategies}"
+foreach name [lreverse $offered] {
+    set sentBefore $::pvr::gui::view::sent
+    $box set $name
+    event generate $box <<ComboboxSelected>>
+    .layout.buttons.apply invoke
+    waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+    set inForce [dict get [$::pvr::gui::session list status] remote strategy]
+    check "strategy box: $name is in force and renders a frame, no error on the status line" \
+        {$inForce eq $name && [string match "frame * in * ms*" $::pvr::gui::statusText] && $::pvr::gui::errors == 0} \
+        "in force $inForce; status: $::pvr::gui::statusText"
+}
+
+# ---- Step 10: artifacts ----
 $photo write [file join $arg(-out) gui_frame.png] -format png
 check "artifact: gui_frame.png written" {[file size [file join $arg(-out) gui_frame.png]] > 100}
 update

@@ -1,0 +1,101 @@
+// Session: one arrived frame into the image sinks (`image window`, `dir`,
+// `file`, `callback`), and the animated file ffmpeg assembles after a
+// sequence written with `image file out.gif|.mp4`.
+#include <cstdio>
+
+#include "session.h"
+
+namespace pvr::tcl {
+
+void Session::handleFrame(Sequence& seq, const proto::ImageFrame& f, bool final) {
+  const std::uint32_t id = seq.id;
+  FrameRecord r;
+  r.frame = f.frameNumber;
+  r.timing = f.timing;
+  r.arrival = seconds(Clock::now() - seq.sent);
+  r.width = int(f.width);
+  r.height = int(f.height);
+  seq.frames.push_back(r);
+  last_ = seq;
+  const std::uint64_t number = framesReceived_++;
+  const Pixels pixels = decodePixels(f);
+
+  // Sinks: the photo, then files, then the callback (which may look at both).
+  if (!photo_.empty()) putPhoto(interp_, photo_, pixels);
+  const auto numbered = [&](const std::string& pattern) {
+    char buf[4096];
+    std::snprintf(buf, sizeof buf, pattern.c_str(), static_cast<unsigned long long>(number));
+    return std::string(buf);
+  };
+  if (!dir_.empty()) {
+    std::string base = name_;
+    if (!base.empty() && base[0] == ':') base.erase(0, 1);
+    writePng(pixels, numbered(dir_ + "/" + base + "_%05llu.png"));
+  }
+  if (!filePattern_.empty()) {
+    writePng(pixels, numbered(filePattern_));
+    if (seq.frames.size() == 1) firstFileNumber_ = number;
+  }
+  if (progressOn(interp_)) printProgress(seq);
+  if (callback_) {
+    runImageCallback(r);
+    if (deleted_) return;  // the callback deleted this session
+  }
+  const auto it = sequences_.find(id);
+  if (final || (it != sequences_.end() && it->second.frames.size() >= it->second.total)) finishSequence(id);
+}
+
+void Session::runImageCallback(const FrameRecord& r) {
+  Tcl_Obj* cmd = Tcl_DuplicateObj(callback_);
+  Tcl_IncrRefCount(cmd);
+  Tcl_ListObjAppendElement(nullptr, cmd, Tcl_NewWideIntObj(r.frame));
+  Tcl_ListObjAppendElement(nullptr, cmd, timingDict(r));
+  Tcl_InterpState saved = Tcl_SaveInterpState(interp_, TCL_OK);
+  const int rc = Tcl_EvalObjEx(interp_, cmd, TCL_EVAL_GLOBAL);
+  Tcl_DecrRefCount(cmd);
+  if (rc != TCL_OK) {
+    Tcl_AddErrorInfo(interp_, "\n    (image callback of session ");
+    Tcl_AddErrorInfo(interp_, name_.c_str());
+    Tcl_AddErrorInfo(interp_, ")");
+    // A running `wait` raises the error; otherwise it is a background error.
+    if (waiters_ > 0 && !waitError_) {
+      Tcl_Obj* code = Tcl_GetVar2Ex(interp_, "errorCode", nullptr, TCL_GLOBAL_ONLY);
+      std::vector<std::string> codeList{"PVR", "CALLBACK"};
+      if (code) codeList.push_back(Tcl_GetString(code));
+      waitError_ = TclError(codeList, std::string("image callback failed: ") + Tcl_GetStringResult(interp_));
+    } else {
+      Tcl_BackgroundException(interp_, rc);
+    }
+  }
+  Tcl_RestoreInterpState(interp_, saved);
+}
+
+void Session::assembleAnimation(const Sequence& seq) {
+  // The frames were written as numbered PNGs beside the target; ffmpeg,
+  // where installed, turns this sequence's into the file.
+  if (animatedTarget_.empty() || seq.frames.empty()) return;
+  std::string input = filePattern_;
+  const auto at = input.find("%05llu");
+  if (at != std::string::npos) input.replace(at, 6, "%05d");
+  Tcl_InterpState saved = Tcl_SaveInterpState(interp_, TCL_OK);
+  const bool found = Tcl_Eval(interp_, "auto_execok ffmpeg") == TCL_OK && *Tcl_GetStringResult(interp_) != '\0';
+  if (!found) {
+    std::fprintf(stderr, "%s: ffmpeg is not installed; %s not written (the frames are %s)\n", name_.c_str(),
+                 animatedTarget_.c_str(), input.c_str());
+  } else {
+    Tcl_Obj* cmd = Tcl_NewListObj(0, nullptr);
+    Tcl_IncrRefCount(cmd);
+    for (const std::string& a : {std::string("exec"), std::string("ffmpeg"), std::string("-y"), std::string("-loglevel"),
+                                 std::string("error"), std::string("-framerate"), std::string("10"),
+                                 std::string("-start_number"), std::to_string(firstFileNumber_), std::string("-i"), input,
+                                 animatedTarget_, std::string("2>@1")})
+      Tcl_ListObjAppendElement(nullptr, cmd, Tcl_NewStringObj(a.c_str(), -1));
+    if (Tcl_EvalObjEx(interp_, cmd, TCL_EVAL_GLOBAL) != TCL_OK)
+      std::fprintf(stderr, "%s: ffmpeg could not write %s: %s\n", name_.c_str(), animatedTarget_.c_str(),
+                   Tcl_GetStringResult(interp_));
+    Tcl_DecrRefCount(cmd);
+  }
+  Tcl_RestoreInterpState(interp_, saved);
+}
+
+}  // namespace pvr::tcl

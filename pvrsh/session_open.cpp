@@ -1,0 +1,96 @@
+// Session::open: connect, Hello and Welcome, the token challenge when the
+// server asks (HMAC-SHA256 of its nonce keyed with the shared token), and
+// SessionOpen, which starts the MPI job (docs/protocol.md, "The conversation").
+#include <openssl/evp.h>
+#include <openssl/hmac.h>
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <sstream>
+
+#include "session.h"
+
+namespace pvr::tcl {
+namespace {
+
+// The shared token of a token file (trailing whitespace dropped).
+std::string readToken(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw TclError({"PVR", "CONNECT", "TOKEN"}, "cannot read token file " + path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  std::string token = s.str();
+  while (!token.empty() && std::isspace(static_cast<unsigned char>(token.back()))) token.pop_back();
+  if (token.empty()) throw TclError({"PVR", "CONNECT", "TOKEN"}, "token file " + path + " is empty");
+  return token;
+}
+
+}  // namespace
+
+void Session::open(const std::string& host, int port, std::uint32_t ranks, const std::string& tokenFile, double timeout) {
+  if (state_ == State::kOpen || state_ == State::kConnecting)
+    throw TclError({"PVR", "STATE", "OPEN"}, "session " + name_ + " is already open to " + peer_ + " (close it first)");
+  const std::string token = tokenFile.empty() ? std::string() : readToken(tokenFile);
+  Tcl_Preserve(this);
+  try {
+    // Step 1: TCP connect on the event loop.
+    conn_.reset();
+    pending_.clear();
+    sequences_.clear();
+    closeReason_.clear();
+    lastFailure_.reset();
+    state_ = State::kConnecting;
+    peer_ = host + ":" + std::to_string(port);
+    conn_ = std::make_unique<Connection>(*this, host, port, std::min(timeout, 30.0));
+    runEventsUntil([&] { return !conn_ || conn_->connected() || conn_->failed(); }, timeout);
+    if (!conn_ || !conn_->connected()) {
+      if (conn_ && !conn_->failed())
+        throw TclError({"PVR", "CONNECT", "TIMEOUT"}, "cannot connect to " + peer_ + ": timed out");
+      if (lastFailure_) throw *lastFailure_;
+      throw TclError({"PVR", "CONNECT", "FAILED"}, "cannot connect to " + peer_);
+    }
+    // Step 2: Hello, Welcome, and the token challenge when the server asks.
+    const auto hello = query(proto::Hello{"pvrsh " PVR_PACKAGE_VERSION}, timeout);
+    const auto* welcome = std::get_if<proto::Welcome>(&hello.front());
+    if (!welcome) throw TclError({"PVR", "PROTOCOL", "UNEXPECTED_MESSAGE"}, peer_ + " did not answer Hello with Welcome");
+    serverSoftware_ = welcome->software;
+    maxRanks_ = welcome->maxRanks;
+    if (welcome->authRequired) {
+      const auto* challenge = hello.size() > 1 ? std::get_if<proto::AuthChallenge>(&hello[1]) : nullptr;
+      if (!challenge) throw TclError({"PVR", "PROTOCOL", "UNEXPECTED_MESSAGE"}, peer_ + " asked for a token but sent no challenge");
+      if (token.empty())
+        throw TclError({"PVR", "CONNECT", "TOKEN"}, peer_ + " requires a token: open with -token-file FILE");
+      proto::AuthResponse response;
+      unsigned int len = 0;
+      HMAC(EVP_sha256(), token.data(), int(token.size()), challenge->nonce.data(), challenge->nonce.size(),
+           response.mac.data(), &len);
+      query(response, timeout);
+    }
+    // Step 3: start the MPI job with the layout set so far.
+    if (ranks > 0 && maxRanks_ > 0 && ranks > maxRanks_)
+      throw TclError({"PVR", "ARGS", "RANKS"}, "-ranks " + std::to_string(ranks) + " is more than " + peer_ +
+                                                   " allows (" + std::to_string(maxRanks_) + ")");
+    const auto ready = query(proto::SessionOpen{ranks, settings_.clusters}, std::max(timeout, 120.0));
+    const auto* r = std::get_if<proto::SessionReady>(&ready.front());
+    if (!r) throw TclError({"PVR", "PROTOCOL", "UNEXPECTED_MESSAGE"}, peer_ + " did not answer SessionOpen with SessionReady");
+    ranks_ = r->rankCount;
+    layout_ = r->clusters;
+    state_ = State::kOpen;
+    layoutPending_ = false;
+    // Step 4: what was set before the session opened.
+    if (!settings_.dataset.empty() || !settings_.scene.empty())
+      send(proto::SetScene{settings_.dataset, settings_.scene.empty() ? std::string() : settings_.scene.dump()}, false);
+  } catch (...) {
+    if (!deleted_) {
+      conn_.reset();
+      pending_.clear();
+      state_ = State::kFailed;
+    }
+    Tcl_Release(this);
+    throw;
+  }
+  Tcl_Release(this);
+}
+
+}  // namespace pvr::tcl
