@@ -220,14 +220,14 @@ void Session::onMaster(proto::RelayItem item) {
 void Session::refuseMasterFrame(const proto::RefusedFrame& refused) {
   const std::uint32_t id = refused.header.requestId;
   const bool final = (refused.header.flags & proto::kFlagFinal) != 0;
-  const std::string what = std::string(refused.info->name) + " frame from the rendering job";
-  log("refused a " + what + " for request " + std::to_string(id) + ": " + refused.error.text);
+  const std::string what = "the rendering job's " + std::string(refused.info->name);
+  log("refused " + what + " for request " + std::to_string(id) + ": " + refused.error.text);
   if (refusedRequests_.count(id)) {
     if (final) refusedRequests_.erase(id);
     return;
   }
   // The session goes on: the frame's end was known, the stream is intact.
-  replyError(refused.error.code, "pvrd refused a " + what + ": " + refused.error.text, id);
+  replyError(refused.error.code, "pvrd refused " + what + ": " + refused.error.text, id);
   if (!final && id != 0) refusedRequests_.insert(id);
 }
 

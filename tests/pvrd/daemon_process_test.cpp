@@ -367,40 +367,40 @@ TEST_CASE("frames the master sends over the limits are refused with an Error nam
     // Ok, and nothing before it: the dropped rest of a refused request never arrives.
     c.expect<proto::Ok>();
   };
-  const auto renderGood = [&] {
-    script(fake::kScriptGood);
+  // The one answer to a RenderFrame under script `name`, FINAL for its request.
+  const auto render = [&](std::string_view name) {
+    script(name);
     const auto id = c.send(proto::RenderFrame{});
-    const auto d = c.next();
+    auto d = c.next();
     REQUIRE(d);
     CHECK(d->info == proto::FrameInfo{id, proto::kFlagFinal});
-    REQUIRE(std::holds_alternative<proto::ImageFrame>(d->message));
+    return std::move(*d);
+  };
+  const auto refusal = [&](std::string_view name) {
+    const auto d = render(name);
+    REQUIRE(std::holds_alternative<proto::ErrorMessage>(d.message));
+    return std::get<proto::ErrorMessage>(d.message);
+  };
+  const auto renderGood = [&] {
+    const auto d = render(fake::kScriptGood);
+    REQUIRE(std::holds_alternative<proto::ImageFrame>(d.message));
     // Relayed as the master sent it: equal messages encode to equal bytes.
-    CHECK(proto::encode(d->message, id, proto::kFlagFinal) == proto::encode(fake::fakeGoodFrame(), id, proto::kFlagFinal));
+    const auto id = d.info.requestId;
+    CHECK(proto::encode(d.message, id, proto::kFlagFinal) == proto::encode(fake::fakeGoodFrame(), id, proto::kFlagFinal));
   };
   renderGood();
 
   SECTION("an ImageFrame payload over the frame limit") {
-    script(fake::kScriptOversize);
-    const auto id = c.send(proto::RenderFrame{});
-    const auto d = c.next();
-    REQUIRE(d);
-    CHECK(d->info == proto::FrameInfo{id, proto::kFlagFinal});
-    const auto* e = std::get_if<proto::ErrorMessage>(&d->message);
-    REQUIRE(e);
-    CHECK(e->code == proto::ErrorCode::kFrameTooLarge);
-    CHECK_THAT(e->text, Catch::Contains("ImageFrame payload of " + std::to_string(proto::kMaxFrameBytes - 15) +
-                                        " bytes exceeds the limit of " + std::to_string(proto::kMaxFrameBytes - 16)));
+    const auto e = refusal(fake::kScriptOversize);
+    CHECK(e.code == proto::ErrorCode::kFrameTooLarge);
+    CHECK_THAT(e.text, Catch::StartsWith("pvrd refused the rendering job's ImageFrame: frame too large: "));
+    CHECK_THAT(e.text, Catch::Contains("ImageFrame payload of " + std::to_string(proto::kMaxFrameBytes - 15) +
+                                       " bytes exceeds the limit of " + std::to_string(proto::kMaxFrameBytes - 16)));
   }
   SECTION("an ImageFrame whose pixel count disagrees with its size") {
-    script(fake::kScriptInconsistent);
-    const auto id = c.send(proto::RenderFrame{});
-    const auto d = c.next();
-    REQUIRE(d);
-    CHECK(d->info == proto::FrameInfo{id, proto::kFlagFinal});
-    const auto* e = std::get_if<proto::ErrorMessage>(&d->message);
-    REQUIRE(e);
-    CHECK(e->code == proto::ErrorCode::kMalformedPayload);
-    CHECK_THAT(e->text, Catch::Contains("needs 12 pixel bytes, got 11"));
+    const auto e = refusal(fake::kScriptInconsistent);
+    CHECK(e.code == proto::ErrorCode::kMalformedPayload);
+    CHECK_THAT(e.text, Catch::Contains("needs 12 pixel bytes, got 11"));
   }
   renderGood();
   c.send(proto::Close{"done"});
