@@ -1,10 +1,15 @@
-// libFuzzer target for the protocol decoder.
+// libFuzzer target for the protocol decoder, relay and pixel codec.
 //
 // For any input: decodeFrame, applied frame after frame, and FrameDecoder,
 // fed the same bytes in chunks whose sizes the input determines, must agree
 // (same messages, same error code); every decoded message must re-encode to
 // exactly the bytes it came from; FrameDecoder must never hold more than one
-// frame. Any disagreement aborts, which libFuzzer reports as a crash; the
+// frame. FrameRelay, fed the same chunks, must pass on exactly the frames
+// the decoder accepts, byte for byte, and refuse the frame the decoder
+// stops at with the same error code. Every decoded ImageFrame's pixels either
+// decompress to width * height * channels bytes that setPixels compresses
+// back to pixels decoding to the same bytes, or fail with an error text.
+// Any disagreement aborts, which libFuzzer reports as a crash; the
 // sanitizers report the rest.
 #include <cstdint>
 #include <cstdio>
@@ -41,6 +46,26 @@ struct WholeResult {
   std::size_t unfinishedBytes = 0;  // bytes of a frame still waiting for more
 };
 
+// The pixel codec on a decoded frame: decompression fails cleanly or
+// round-trips through the encoder.
+void checkPixels(const ImageFrame& frame, const Limits& limits) {
+  auto raw = decompressPixels(frame, limits);
+  if (auto* error = std::get_if<ProtocolError>(&raw)) {
+    require(!error->text.empty(), "a pixel error without text");
+    return;
+  }
+  const auto& pixels = std::get<std::vector<std::uint8_t>>(raw);
+  require(pixels.size() == std::size_t{frame.width} * frame.height * channelCount(frame.format),
+          "decompressed pixels of the wrong size");
+  ImageFrame again = frame;
+  setPixels(again, pixels, frame.compression);
+  require(again.pixels.size() <= pixels.size(), "setPixels made the pixels larger");
+  auto back = decompressPixels(again, limits);
+  require(std::holds_alternative<std::vector<std::uint8_t>>(back) &&
+              std::get<std::vector<std::uint8_t>>(back) == pixels,
+          "pixels do not survive compress and decompress");
+}
+
 WholeResult decodeWhole(std::span<const std::uint8_t> input, const Limits& limits) {
   WholeResult whole;
   while (!input.empty()) {
@@ -53,6 +78,7 @@ WholeResult decodeWhole(std::span<const std::uint8_t> input, const Limits& limit
       require(again.size() == original.size() && std::equal(again.begin(), again.end(), original.begin()),
               "a decoded message does not re-encode to its bytes");
       whole.frames.push_back(std::move(again));
+      if (const auto* image = std::get_if<ImageFrame>(&decoded->message)) checkPixels(*image, limits);
       input = input.subspan(decoded->bytesConsumed);
     } else if (auto* error = std::get_if<ProtocolError>(&result)) {
       require(!error->text.empty(), "an error without text");
@@ -82,23 +108,51 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::uint64_t seed = size;
   for (std::size_t i = 0; i < size && i < 8; ++i) seed = seed * 131 + data[i];
   FrameDecoder decoder(limits);
+  FrameRelay relay(limits);
   std::size_t at = 0;
   std::size_t popped = 0;
+  std::size_t relayed = 0;
+  std::optional<ProtocolError> firstRefusal;
   while (at < size) {
     const std::uint64_t r = nextRandom(seed);
     const std::size_t chunk = 1 + static_cast<std::size_t>((r & 0xF) == 0 ? (r >> 8) % 4096 : (r >> 8) % 64);
     const std::size_t n = std::min(chunk, size - at);
     decoder.feed(input.subspan(at, n));
+    relay.feed(input.subspan(at, n));
     at += n;
     require(decoder.bufferedBytes() <= limits.maxFrameBytes, "decoder holds more than one frame");
+    require(relay.bufferedBytes() <= limits.maxFrameBytes, "relay holds more than one frame");
     while (auto frame = decoder.pop()) {
       require(popped < whole.frames.size(), "the decoder produced an extra message");
       const auto again = encode(frame->message, frame->info.requestId, frame->info.flags);
       require(again == whole.frames[popped], "chunked and whole decoding disagree on a message");
       ++popped;
     }
+    // Up to the decoder's first error the relay passes on the same frames;
+    // after a refusal it may go on where the decoder stops.
+    while (auto item = relay.pop()) {
+      if (firstRefusal) continue;
+      if (auto* refused = std::get_if<RefusedFrame>(&*item)) {
+        firstRefusal = refused->error;
+        continue;
+      }
+      const auto& frame = std::get<RelayedFrame>(*item);
+      require(relayed < whole.frames.size(), "the relay passed a frame the decoder refuses");
+      require(frame.bytes == whole.frames[relayed], "the relay changed a frame's bytes");
+      ++relayed;
+    }
   }
   require(popped == whole.frames.size(), "the decoder lost a message");
+  const auto& relayError = relay.endOfStream();
+  if (!firstRefusal) {
+    require(relayed == whole.frames.size(), "the relay lost a frame");
+  }
+  if (whole.error) {
+    const ProtocolError& refusal = firstRefusal ? *firstRefusal : relayError.value_or(ProtocolError{});
+    // Codes only: a wrong magic's text shows the bytes seen so far, which
+    // depend on the chunking.
+    require(refusal.code == whole.error->code, "the relay and the decoder disagree on the first error");
+  }
 
   const auto& error = decoder.endOfStream();
   if (whole.error) {

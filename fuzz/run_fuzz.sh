@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds the protocol decoder fuzzer with clang in its own build directory
-# and runs it for a bounded time on a copy of the seed corpus.
+# Builds the protocol fuzzer (decoder, relay, pixel codec) with clang in its
+# own build directory and runs it for a bounded time on a copy of the seed
+# corpus.
 #
 # Usage: fuzz/run_fuzz.sh [SECONDS]      (default 60)
 # Environment: PVR_FUZZ_BUILD_DIR (default build-fuzz at the repository root).

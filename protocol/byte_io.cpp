@@ -1,5 +1,6 @@
 #include "byte_io.h"
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <limits>
@@ -32,6 +33,10 @@ void ByteReader::raw(std::span<std::uint8_t> out) {
   if (!need(out.size(), "bytes")) return;
   if (!out.empty()) std::memcpy(out.data(), bytes_.data() + pos_, out.size());
   pos_ += out.size();
+}
+
+void ByteReader::skip(std::size_t n) {
+  if (need(n, "bytes")) pos_ += n;
 }
 
 std::uint32_t ByteReader::count(std::size_t minElementBytes, const char* what) {
@@ -72,6 +77,14 @@ bool ByteReader::need(std::size_t n, const char* what) {
     return false;
   }
   return true;
+}
+
+void appendToFrame(std::vector<std::uint8_t>& buffer, std::span<const std::uint8_t> bytes, std::size_t frameBytes) {
+  const std::size_t needed = buffer.size() + bytes.size();
+  if (needed > buffer.capacity()) {
+    buffer.reserve(std::min(frameBytes, std::max(needed, 2 * buffer.capacity())));
+  }
+  buffer.insert(buffer.end(), bytes.begin(), bytes.end());
 }
 
 }  // namespace pvr::proto

@@ -65,6 +65,8 @@ class ByteReader {
   double f64();
   // Copies out.size() bytes; fails if fewer are left.
   void raw(std::span<std::uint8_t> out);
+  // Steps over n bytes without reading them; fails if fewer are left.
+  void skip(std::size_t n);
   // Reads a u32 element count and checks that `count * minElementBytes`
   // bytes are left before anyone allocates for them. Returns 0 on failure.
   std::uint32_t count(std::size_t minElementBytes, const char* what);
@@ -88,5 +90,11 @@ class ByteReader {
   std::string context_;
   std::optional<ProtocolError> error_;
 };
+
+// Appends `bytes` to `buffer` (an unfinished frame), growing its capacity
+// with what has arrived, never past `frameBytes`, the frame's announced and
+// already checked size: capacity follows the bytes received, not a length
+// read off the wire.
+void appendToFrame(std::vector<std::uint8_t>& buffer, std::span<const std::uint8_t> bytes, std::size_t frameBytes);
 
 }  // namespace pvr::proto

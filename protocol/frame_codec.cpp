@@ -28,10 +28,12 @@ std::string hex(unsigned value, int width) {
   return digits;
 }
 
+// "ImageFrame payload": how error texts name what they read.
+std::string payloadContext(const MessageInfo& info) { return std::string(info.name) + " payload"; }
+
 }  // namespace
 
-std::variant<NeedMore, CheckedHeader, ProtocolError> checkHeader(std::span<const std::uint8_t> prefix,
-                                                                 const Limits& limits) {
+std::variant<NeedMore, CheckedHeader, ProtocolError> checkHeaderFields(std::span<const std::uint8_t> prefix) {
   // Each field is checked as soon as its bytes are there.
   if (!magicPrefixMatches(prefix)) {
     const auto seen = prefix.first(std::min(prefix.size(), kMagic.size()));
@@ -54,14 +56,32 @@ std::variant<NeedMore, CheckedHeader, ProtocolError> checkHeader(std::span<const
     return ProtocolError{ErrorCode::kReservedFlags, "reserved flag bits " + hex(header.flags & ~kKnownFlags, 4) +
                                                         " set in a " + std::string(checked.info->name) + " header"};
   }
+  return checked;
+}
+
+std::optional<ProtocolError> checkPayloadLength(const CheckedHeader& checked, const Limits& limits) {
   const std::uint32_t limit = payloadLimit(*checked.info, limits);
-  if (header.payloadBytes > limit) {
-    return ProtocolError{ErrorCode::kFrameTooLarge, "frame too large: " + std::string(checked.info->name) +
-                                                        " payload of " + std::to_string(header.payloadBytes) +
-                                                        " bytes exceeds the limit of " + std::to_string(limit) +
-                                                        " bytes"};
+  if (checked.header.payloadBytes <= limit) return std::nullopt;
+  return ProtocolError{ErrorCode::kFrameTooLarge, "frame too large: " + std::string(checked.info->name) +
+                                                      " payload of " + std::to_string(checked.header.payloadBytes) +
+                                                      " bytes exceeds the limit of " + std::to_string(limit) +
+                                                      " bytes"};
+}
+
+std::variant<NeedMore, CheckedHeader, ProtocolError> checkHeader(std::span<const std::uint8_t> prefix,
+                                                                 const Limits& limits) {
+  auto checked = checkHeaderFields(prefix);
+  if (const auto* header = std::get_if<CheckedHeader>(&checked)) {
+    if (auto tooLarge = checkPayloadLength(*header, limits)) return std::move(*tooLarge);
   }
   return checked;
+}
+
+std::optional<ProtocolError> checkPayload(const CheckedHeader& checked, std::span<const std::uint8_t> payload,
+                                          const Limits& limits) {
+  ByteReader reader(payload, payloadContext(*checked.info));
+  checked.info->checkPayload(reader, limits);
+  return reader.error();
 }
 
 std::vector<std::uint8_t> encode(const Message& message, std::uint32_t requestId, std::uint16_t flags) {
@@ -92,7 +112,7 @@ DecodeResult decodeFrame(std::span<const std::uint8_t> bytes, const Limits& limi
   const std::size_t frameBytes = kHeaderBytes + header.payloadBytes;
   if (bytes.size() < frameBytes) return NeedMore{frameBytes};
 
-  ByteReader reader(bytes.subspan(kHeaderBytes, header.payloadBytes), std::string(info->name) + " payload");
+  ByteReader reader(bytes.subspan(kHeaderBytes, header.payloadBytes), payloadContext(*info));
   Message message = info->decodePayload(reader, limits);
   if (!reader.ok()) return *reader.error();
   return Decoded{std::move(message), FrameInfo{header.requestId, header.flags}, frameBytes};

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <variant>
 #include <vector>
@@ -50,9 +51,24 @@ struct CheckedHeader {
 
 // Checks the header fields present in `prefix` (any length; bytes past the
 // header are ignored): magic, version, type, reserved flags, then the payload
-// length against payloadLimit() for that type.
+// length against payloadLimit() for that type (checkPayloadLength).
 std::variant<NeedMore, CheckedHeader, ProtocolError> checkHeader(std::span<const std::uint8_t> prefix,
                                                                  const Limits& limits);
+
+// The first four checks of checkHeader: after an error here the stream
+// cannot be trusted any more.
+std::variant<NeedMore, CheckedHeader, ProtocolError> checkHeaderFields(std::span<const std::uint8_t> prefix);
+
+// The last check of checkHeader: kFrameTooLarge when the payload length is
+// over payloadLimit() for the type. The frame's end is still known, so a
+// relay may skip it and go on (frame_relay.h).
+std::optional<ProtocolError> checkPayloadLength(const CheckedHeader& checked, const Limits& limits);
+
+// Checks a whole payload of the checked header's type exactly as decodeFrame
+// does (same code, same text) without keeping the message (MessageInfo::
+// checkPayload: an ImageFrame's pixels are not copied).
+std::optional<ProtocolError> checkPayload(const CheckedHeader& checked, std::span<const std::uint8_t> payload,
+                                          const Limits& limits);
 
 // One frame. Throws std::invalid_argument for reserved flag bits and
 // std::length_error for a payload past 4 GiB - 1 bytes. It does not apply

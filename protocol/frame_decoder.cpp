@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <string>
 
+#include "byte_io.h"
+
 namespace pvr::proto {
 
 void FrameDecoder::feed(std::span<const std::uint8_t> bytes) {
@@ -17,7 +19,7 @@ void FrameDecoder::feed(std::span<const std::uint8_t> bytes) {
         frameBytes = kHeaderBytes + header->header.payloadBytes;
       }
       const std::size_t take = std::min(frameBytes - partial_.size(), bytes.size());
-      appendToPartial(bytes.first(take), frameBytes);
+      appendToFrame(partial_, bytes.first(take), frameBytes);
       bytes = bytes.subspan(take);
     }
     // With nothing held, decode straight from the input without copying.
@@ -33,20 +35,10 @@ void FrameDecoder::feed(std::span<const std::uint8_t> bytes) {
     } else if (partial_.empty()) {
       // The input ends inside this frame: keep it (it is shorter than the
       // frame, whose header, if complete, passed the limits).
-      appendToPartial(bytes, std::get<NeedMore>(result).frameBytes);
+      appendToFrame(partial_, bytes, std::get<NeedMore>(result).frameBytes);
       bytes = {};
     }
   }
-}
-
-void FrameDecoder::appendToPartial(std::span<const std::uint8_t> bytes, std::size_t frameBytes) {
-  // Grow geometrically with what has arrived, never past the frame's size:
-  // capacity follows the bytes received, not the length announced.
-  const std::size_t needed = partial_.size() + bytes.size();
-  if (needed > partial_.capacity()) {
-    partial_.reserve(std::min(frameBytes, std::max(needed, 2 * partial_.capacity())));
-  }
-  partial_.insert(partial_.end(), bytes.begin(), bytes.end());
 }
 
 std::optional<Decoded> FrameDecoder::pop() {

@@ -42,8 +42,6 @@ class FrameDecoder {
   std::size_t bufferedBytes() const { return partial_.size(); }
 
  private:
-  void appendToPartial(std::span<const std::uint8_t> bytes, std::size_t frameBytes);
-
   Limits limits_;
   std::vector<std::uint8_t> partial_;
   std::deque<Decoded> ready_;

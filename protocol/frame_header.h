@@ -32,8 +32,12 @@ inline constexpr std::uint16_t kFlagFinal = 0x0001;
 inline constexpr std::uint16_t kKnownFlags = kFlagFinal;
 
 // Largest frame (header + payload) a receiver accepts by default: an
-// uncompressed 4096 x 4096 RGBA image fits.
+// uncompressed 4096 x 4096 RGB image fits (proto::checkImageSize decides
+// which image sizes do).
 inline constexpr std::uint32_t kMaxFrameBytes = 64u << 20;
+
+// The most frames one RenderRotation may ask for (end - start + 1).
+inline constexpr std::uint32_t kMaxRotationFrames = 100000;
 
 // Receiver-side limits, checked against the header before any payload byte
 // is buffered or any allocation is sized. Each message type names the field
@@ -44,6 +48,7 @@ struct Limits {
   std::uint32_t maxControlPayload = 64u << 10;   // hello, auth, session, render, ...
   std::uint32_t maxTextPayload = 4u << 20;       // scene JSON, status, catalog, performance
   std::uint64_t maxImagePixels = 8192ull * 8192ull;  // width * height of an ImageFrame
+  std::uint32_t maxRotationFrames = kMaxRotationFrames;  // frames of one RenderRotation
 };
 
 struct FrameHeader {

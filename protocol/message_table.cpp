@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <tuple>
+#include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "field_codec.h"
 
@@ -29,13 +32,38 @@ Message decodeAs(ByteReader& reader, const Limits& limits) {
   return message;
 }
 
+template <class T>
+void checkAs(ByteReader& reader, const Limits& limits) {
+  if constexpr (requires(T& m) { T::headFields(m); m.checkHead(std::uint64_t{0}, limits); }) {
+    // The bulk field is a u32 byte count and the bytes (field_codec.h): the
+    // count is checked against the bytes left as readField would, then the
+    // bytes are stepped over.
+    using Head = decltype(T::headFields(std::declval<T&>()));
+    using All = decltype(T::fields(std::declval<T&>()));
+    static_assert(std::tuple_size_v<All> == std::tuple_size_v<Head> + 1 &&
+                      std::is_same_v<std::tuple_element_t<std::tuple_size_v<Head>, All>, std::vector<std::uint8_t>&>,
+                  "fields() must be headFields() followed by one byte array");
+    T message{};
+    std::apply([&](auto&... field) { (readField(reader, field), ...); }, T::headFields(message));
+    const std::uint32_t bulkBytes = reader.count(1, "byte array");
+    reader.skip(bulkBytes);
+    reader.expectEnd();
+    if (reader.ok()) {
+      if (auto problem = message.checkHead(bulkBytes, limits)) reader.fail(problem->code, std::move(problem->text));
+    }
+  } else {
+    decodeAs<T>(reader, limits);
+  }
+}
+
 template <std::size_t... I>
 constexpr std::array<MessageInfo, kMessageCount> makeTable(std::index_sequence<I...>) {
   return {MessageInfo{std::variant_alternative_t<I, Message>::kWire.type,
                       std::variant_alternative_t<I, Message>::kWire.name,
                       std::variant_alternative_t<I, Message>::kWire.maxPayload, I,
                       &encodeAs<std::variant_alternative_t<I, Message>>,
-                      &decodeAs<std::variant_alternative_t<I, Message>>}...};
+                      &decodeAs<std::variant_alternative_t<I, Message>>,
+                      &checkAs<std::variant_alternative_t<I, Message>>}...};
 }
 
 constexpr std::array<MessageInfo, kMessageCount> kTable = makeTable(std::make_index_sequence<kMessageCount>{});

@@ -24,6 +24,11 @@ struct MessageInfo {
   // Reads a whole payload (trailing bytes are an error) and applies check();
   // on failure the reader holds the error and the result is unspecified.
   Message (*decodePayload)(ByteReader& reader, const Limits& limits) = nullptr;
+  // Fails the reader exactly where decodePayload would, keeping nothing: a
+  // message with headFields (ImageFrame) is checked from its head fields and
+  // bulk byte count, its bulk bytes skipped, not copied; others are decoded
+  // and dropped.
+  void (*checkPayload)(ByteReader& reader, const Limits& limits) = nullptr;
 };
 
 // One entry per alternative of Message, in variant order.

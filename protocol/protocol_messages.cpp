@@ -1,24 +1,57 @@
 #include "protocol_messages.h"
 
+#include <cmath>
+
+#include "image_limits.h"
+
 namespace pvr::proto {
 
-std::optional<ProtocolError> ImageFrame::check(const Limits& limits) const {
+std::optional<ProtocolError> RenderRotation::check(const Limits& limits) const {
+  const std::string steps = "steps " + std::to_string(start) + " to " + std::to_string(end);
+  if (stepsPerTurn == 0) {
+    return ProtocolError{ErrorCode::kBadArgument, "rotation of " + steps + " has 0 steps per turn; it needs at least 1"};
+  }
+  if (end < start) {
+    return ProtocolError{ErrorCode::kBadArgument, "rotation of " + steps + ": the end step is below the start step"};
+  }
+  // 64-bit: end - start + 1 reaches 2^32 for the widest int32 range.
+  const std::int64_t frames = std::int64_t{end} - start + 1;
+  if (frames > limits.maxRotationFrames) {
+    return ProtocolError{ErrorCode::kLimitExceeded, "rotation of " + steps + " asks for " + std::to_string(frames) +
+                                                        " frames, over the protocol's limit of " +
+                                                        std::to_string(limits.maxRotationFrames) +
+                                                        " frames per request"};
+  }
+  // The receiver divides the axis by its length: the length must be a
+  // finite nonzero number (hypot neither underflows nor overflows early).
+  const double length = std::hypot(axis[0], axis[1], axis[2]);
+  if (!(length > 0) || !std::isfinite(length)) {
+    return ProtocolError{ErrorCode::kBadArgument, "rotation axis (" + std::to_string(axis[0]) + ", " +
+                                                      std::to_string(axis[1]) + ", " + std::to_string(axis[2]) +
+                                                      ") is not a finite nonzero vector"};
+  }
+  return std::nullopt;
+}
+
+std::optional<ProtocolError> ImageFrame::checkHead(std::uint64_t pixelBytes, const Limits& limits) const {
+  const std::string size = std::to_string(width) + " x " + std::to_string(height);
   if (width == 0 || height == 0) {
-    return ProtocolError{ErrorCode::kMalformedPayload,
-                         "image of " + std::to_string(width) + " x " + std::to_string(height) + " pixels is empty"};
+    return ProtocolError{ErrorCode::kMalformedPayload, "image of " + size + " pixels is empty"};
   }
-  // Both factors < 2^32, so the product fits 64 bits.
-  const std::uint64_t pixelCount = std::uint64_t{width} * height;
-  if (pixelCount > limits.maxImagePixels) {
-    return ProtocolError{ErrorCode::kLimitExceeded, "image of " + std::to_string(width) + " x " +
-                                                        std::to_string(height) + " pixels exceeds the limit of " +
-                                                        std::to_string(limits.maxImagePixels) + " pixels"};
+  if (auto tooLarge = checkImageSize(width, height, format, limits)) return tooLarge;
+  // Both factors < 2^32 and their product passed the pixel limit.
+  const std::uint64_t rawBytes = std::uint64_t{width} * height * channelCount(format);
+  if (compression == Compression::kNone && pixelBytes != rawBytes) {
+    return ProtocolError{ErrorCode::kMalformedPayload, "uncompressed " + size + " image needs " +
+                                                           std::to_string(rawBytes) + " pixel bytes, got " +
+                                                           std::to_string(pixelBytes)};
   }
-  const std::uint64_t rawBytes = pixelCount * channelCount(format);
-  if (compression == Compression::kNone && pixels.size() != rawBytes) {
+  if (compression != Compression::kNone && pixelBytes >= rawBytes) {
     return ProtocolError{ErrorCode::kMalformedPayload,
-                         "uncompressed " + std::to_string(width) + " x " + std::to_string(height) + " image needs " +
-                             std::to_string(rawBytes) + " pixel bytes, got " + std::to_string(pixels.size())};
+                         std::string(compressionName(compression)) + " pixels of " + std::to_string(pixelBytes) +
+                             " bytes are not fewer than the " + std::to_string(rawBytes) +
+                             " bytes of the uncompressed " + size +
+                             " image; such a frame must be sent with compression none"};
   }
   return std::nullopt;
 }

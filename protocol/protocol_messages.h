@@ -6,7 +6,11 @@
 //     its payload;
 //   - fields(self): its payload fields in wire order (field_codec.h says how
 //     each field type is encoded);
-//   - optionally check(limits): rules between fields that decoding enforces.
+//   - optionally check(limits): rules between fields that decoding enforces;
+//   - optionally, when the last field is a bulk byte array (ImageFrame's
+//     pixels), headFields(self) listing the fields before it and
+//     checkHead(bulkBytes, limits) holding check()'s rules, so that a relay
+//     checks the frame without copying the bulk (message_table.h).
 // Adding a message is one struct here plus one line in `Message` below; the
 // look-up table (message_table.h), the codec and the dispatcher follow.
 // docs/protocol.md documents every payload byte by byte.
@@ -48,6 +52,10 @@ constexpr bool isWireValue(PerformanceQuery v) { return v <= PerformanceQuery::k
 constexpr bool isWireValue(ErrorCode) { return true; }
 
 constexpr std::uint32_t channelCount(PixelFormat format) { return format == PixelFormat::kRgba8 ? 4 : 3; }
+// "none", "RLE", "zlib": for error texts.
+constexpr std::string_view compressionName(Compression c) {
+  return c == Compression::kNone ? "none" : c == Compression::kRle ? "RLE" : "zlib";
+}
 
 // ---- Records used inside payloads ----
 
@@ -189,9 +197,10 @@ struct RenderFrame {
   bool operator==(const RenderFrame&) const = default;
 };
 
-// Client -> server: frames k = start..end of a rotation about `axis` through
-// the volume centre, frame k at angle 360 degrees * k / stepsPerTurn
-// ("render rotate 0,1,0 15,59:60" of paper 003 is 45 frames).
+// Client -> server: frames k = start..end of a rotation of the camera about
+// `axis` through its look-at point (for the automatic camera, the volume
+// centre): frame k turns the eye and up vectors by 360 degrees * k /
+// stepsPerTurn ("render rotate 0,1,0 15,59:60" of paper 003 is 45 frames).
 struct RenderRotation {
   static constexpr WireInfo kWire{0x21, "RenderRotation", &Limits::maxControlPayload};
   std::array<double, 3> axis{0, 1, 0};
@@ -199,6 +208,12 @@ struct RenderRotation {
   std::int32_t end = 0;
   std::uint32_t stepsPerTurn = 1;
   static auto fields(auto& self) { return std::tie(self.axis, self.start, self.end, self.stepsPerTurn); }
+  // stepsPerTurn >= 1, start <= end, at most limits.maxRotationFrames frames
+  // (kLimitExceeded), a finite nonzero axis; the others are kBadArgument.
+  // Decoding enforces it; a client may call it before sending.
+  std::optional<ProtocolError> check(const Limits& limits) const;
+  // end - start + 1; meaningful once check() passed.
+  std::uint32_t frameCount() const { return static_cast<std::uint32_t>(std::int64_t{end} - start + 1); }
   bool operator==(const RenderRotation&) const = default;
 };
 
@@ -211,14 +226,19 @@ struct ImageFrame {
   PixelFormat format = PixelFormat::kRgb8;
   Compression compression = Compression::kNone;
   FrameTiming timing;
-  std::vector<std::uint8_t> pixels;  // rows top to bottom, 8-bit sRGB, as compressed
-  static auto fields(auto& self) {
-    return std::tie(self.frameNumber, self.width, self.height, self.format, self.compression, self.timing,
-                    self.pixels);
+  std::vector<std::uint8_t> pixels;  // rows top to bottom, 8-bit sRGB, as compressed (pixel_codec.h)
+  // The fields before the pixels. A relay reads only these and the pixel
+  // byte count, and checks them with checkHead, without copying the pixels.
+  static auto headFields(auto& self) {
+    return std::tie(self.frameNumber, self.width, self.height, self.format, self.compression, self.timing);
   }
-  // width, height >= 1; width * height <= limits.maxImagePixels; uncompressed
-  // pixels are exactly width * height * channels bytes.
-  std::optional<ProtocolError> check(const Limits& limits) const;
+  static auto fields(auto& self) { return std::tuple_cat(headFields(self), std::tie(self.pixels)); }
+  // The rules between the head fields and a pixel byte count: width, height
+  // >= 1 and the size passes checkImageSize (image_limits.h); uncompressed
+  // pixels are exactly width * height * channels bytes, compressed ones
+  // fewer (a sender falls back to kNone when compressing does not pay).
+  std::optional<ProtocolError> checkHead(std::uint64_t pixelBytes, const Limits& limits) const;
+  std::optional<ProtocolError> check(const Limits& limits) const { return checkHead(pixels.size(), limits); }
   bool operator==(const ImageFrame&) const = default;
 };
 

@@ -70,12 +70,14 @@ class Session {
  private:
   void log(const std::string& event) const { logEvent(cfg_.id, event); }
   bool sendClient(const proto::Message& m, std::uint32_t id, bool final = true);
+  bool sendClientBytes(std::span<const std::uint8_t> frame);
   void replyError(ErrorCode code, const std::string& text, std::uint32_t id) {
     sendClient(proto::ErrorMessage{code, text}, id);
   }
   void endConnection(ErrorCode code, const std::string& text, std::uint32_t id);
   void onClient(proto::Decoded frame);
-  void onMaster(const proto::Decoded& frame);
+  void onMaster(proto::RelayItem item);
+  void refuseMasterFrame(const proto::RefusedFrame& refused);
   void forward(const proto::Message& m, std::uint32_t id);
   bool launch(std::uint32_t ranks, std::string& error);
   void drainStderr();
@@ -90,7 +92,12 @@ class Session {
   bool jobExited_ = false;
   int jobStatus_ = 0;
   std::string stderrTail_;
-  proto::FrameDecoder fromClient_, fromMaster_;
+  proto::FrameDecoder fromClient_;
+  // Master frames are checked and passed on as they came, not re-encoded.
+  proto::FrameRelay fromMaster_;
+  // Requests answered with an Error after pvrd refused a master frame: the
+  // master's further frames for them are dropped until its FINAL one.
+  std::set<std::uint32_t> refusedRequests_;
   bool greeted_ = false, authenticated_ = false, done_ = false;
   Nonce nonce_{};
   std::deque<std::vector<std::uint8_t>> pendingToMaster_;
@@ -98,9 +105,13 @@ class Session {
 };
 
 bool Session::sendClient(const proto::Message& m, std::uint32_t id, bool final) {
+  return sendClientBytes(proto::encode(m, id, final ? proto::kFlagFinal : 0));
+}
+
+bool Session::sendClientBytes(std::span<const std::uint8_t> frame) {
   if (client_ < 0) return false;
   std::string error;
-  if (writeAll(client_, proto::encode(m, id, final ? proto::kFlagFinal : 0), error)) return true;
+  if (writeAll(client_, frame, error)) return true;
   log("client write failed: " + error);
   ::close(client_);
   client_ = -1;
@@ -193,9 +204,31 @@ void Session::onClient(proto::Decoded frame) {
   forward(m, id);
 }
 
-void Session::onMaster(const proto::Decoded& frame) {
-  if (std::holds_alternative<proto::Close>(frame.message)) return jobEnded("the master closed the session");
-  sendClient(frame.message, frame.info.requestId, frame.info.final());
+void Session::onMaster(proto::RelayItem item) {
+  if (const auto* refused = std::get_if<proto::RefusedFrame>(&item)) return refuseMasterFrame(*refused);
+  const auto& frame = std::get<proto::RelayedFrame>(item);
+  if (frame.header.type == proto::Close::kWire.type) return jobEnded("the master closed the session");
+  const std::uint32_t id = frame.header.requestId;
+  if (refusedRequests_.count(id)) {
+    // The client already has its Error for this request.
+    if (frame.header.flags & proto::kFlagFinal) refusedRequests_.erase(id);
+    return;
+  }
+  sendClientBytes(frame.bytes);
+}
+
+void Session::refuseMasterFrame(const proto::RefusedFrame& refused) {
+  const std::uint32_t id = refused.header.requestId;
+  const bool final = (refused.header.flags & proto::kFlagFinal) != 0;
+  const std::string what = "the rendering job's " + std::string(refused.info->name);
+  log("refused " + what + " for request " + std::to_string(id) + ": " + refused.error.text);
+  if (refusedRequests_.count(id)) {
+    if (final) refusedRequests_.erase(id);
+    return;
+  }
+  // The session goes on: the frame's end was known, the stream is intact.
+  replyError(refused.error.code, "pvrd refused " + what + ": " + refused.error.text, id);
+  if (!final && id != 0) refusedRequests_.insert(id);
 }
 
 bool Session::launch(std::uint32_t ranks, std::string& error) {
@@ -336,7 +369,8 @@ int Session::run() {
     if (ci >= 0 && (fds[ci].revents & (POLLIN | POLLHUP | POLLERR))) {
       const ssize_t got = ::read(client_, buf.data(), buf.size());
       if (got <= 0) {
-        if (const auto& e = fromClient_.endOfStream()) log("client vanished mid-frame: " + e->text);
+        // A frame left unfinished gets its error, in case the client still reads.
+        if (const auto& e = fromClient_.endOfStream()) endConnection(e->code, e->text, 0);
         log("client disconnected");
         done_ = true;
         break;
@@ -388,8 +422,8 @@ int Session::run() {
         break;
       }
       fromMaster_.feed(std::span(buf.data(), std::size_t(got)));
-      while (auto frame = fromMaster_.pop()) {
-        onMaster(*frame);
+      while (auto item = fromMaster_.pop()) {
+        onMaster(std::move(*item));
         if (done_) break;
       }
       if (!done_ && fromMaster_.error()) jobEnded("bad frame from the master: " + fromMaster_.error()->text);

@@ -1,7 +1,9 @@
 // The session handler: one forked process per client connection. It does
 // hello and authentication, answers catalog requests, launches the MPI job on
-// SessionOpen, relays frames between the client and the master rank, and
-// tears the job down (its whole process group) when either side goes away.
+// SessionOpen, relays frames between the client and the master rank (the
+// master's frames checked and passed on byte for byte, proto::FrameRelay),
+// and tears the job down (its whole process group) when either side goes
+// away.
 #pragma once
 
 #include <cstdint>

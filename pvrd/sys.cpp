@@ -16,19 +16,18 @@ namespace pvr::daemon {
 
 std::string errnoText(const char* call) { return std::string(call) + ": " + std::strerror(errno); }
 
-namespace {
-
-int openBoundOrConnected(const std::string& host, int& port, bool listening, std::string& error) {
+int tcpListen(const std::string& host, int& port, std::string& error) {
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;
   hints.ai_socktype = SOCK_STREAM;
-  hints.ai_flags = listening ? AI_PASSIVE : 0;
+  hints.ai_flags = AI_PASSIVE;
   addrinfo* found = nullptr;
   const std::string service = std::to_string(port);
   if (int rc = ::getaddrinfo(host.c_str(), service.c_str(), &hints, &found); rc != 0) {
     error = "getaddrinfo " + host + ": " + ::gai_strerror(rc);
     return -1;
   }
+  // The first address that binds and listens.
   int fd = -1;
   for (addrinfo* a = found; a && fd < 0; a = a->ai_next) {
     fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
@@ -36,24 +35,17 @@ int openBoundOrConnected(const std::string& host, int& port, bool listening, std
       error = errnoText("socket");
       continue;
     }
-    bool ok;
-    if (listening) {
-      const int one = 1;
-      ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-      ok = ::bind(fd, a->ai_addr, a->ai_addrlen) == 0 || (error = errnoText("bind"), false);
-      ok = ok && (::listen(fd, 128) == 0 || (error = errnoText("listen"), false));
-    } else {
-      ok = ::connect(fd, a->ai_addr, a->ai_addrlen) == 0 || (error = errnoText("connect"), false);
-      const int one = 1;
-      if (ok) ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-    }
+    const int one = 1;
+    ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    const bool ok = (::bind(fd, a->ai_addr, a->ai_addrlen) == 0 || (error = errnoText("bind"), false)) &&
+                    (::listen(fd, 128) == 0 || (error = errnoText("listen"), false));
     if (!ok) {
       ::close(fd);
       fd = -1;
     }
   }
   ::freeaddrinfo(found);
-  if (fd >= 0 && listening) {
+  if (fd >= 0) {
     sockaddr_storage ss{};
     socklen_t len = sizeof ss;
     ::getsockname(fd, reinterpret_cast<sockaddr*>(&ss), &len);
@@ -61,16 +53,6 @@ int openBoundOrConnected(const std::string& host, int& port, bool listening, std
                                     : ntohs(reinterpret_cast<sockaddr_in*>(&ss)->sin_port);
   }
   return fd;
-}
-
-}  // namespace
-
-int tcpListen(const std::string& host, int& port, std::string& error) {
-  return openBoundOrConnected(host, port, true, error);
-}
-
-int tcpConnect(const std::string& host, int port, std::string& error) {
-  return openBoundOrConnected(host, port, false, error);
 }
 
 int tcpAccept(int listenFd, std::string& error) {

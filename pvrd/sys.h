@@ -11,8 +11,6 @@ namespace pvr::daemon {
 // A TCP socket bound to host:port and listening. `port` 0 picks one; the
 // bound port is stored back into it.
 int tcpListen(const std::string& host, int& port, std::string& error);
-// Connects to host:port (blocking).
-int tcpConnect(const std::string& host, int port, std::string& error);
 // accept() with CLOEXEC; -1 and error text on failure.
 int tcpAccept(int listenFd, std::string& error);
 

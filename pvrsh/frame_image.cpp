@@ -12,10 +12,6 @@
 namespace pvr::tcl {
 namespace {
 
-[[noreturn]] void malformed(const std::string& what) {
-  throw TclError({"PVR", "PROTOCOL", "MALFORMED_PAYLOAD"}, "bad image frame: " + what);
-}
-
 void putU32(std::vector<std::uint8_t>& out, std::uint32_t v) {
   for (int shift = 24; shift >= 0; shift -= 8) out.push_back(std::uint8_t(v >> shift));
 }
@@ -32,38 +28,15 @@ void putChunk(std::vector<std::uint8_t>& out, const char type[4], const std::vec
 }  // namespace
 
 Pixels decodePixels(const proto::ImageFrame& frame) {
+  auto decoded = proto::decompressPixels(frame);
+  if (auto* error = std::get_if<proto::ProtocolError>(&decoded))
+    throw TclError({"PVR", "PROTOCOL", std::string(proto::errorCodeName(error->code))}, "bad image frame: " + error->text);
   Pixels p;
   p.width = int(frame.width);
   p.height = int(frame.height);
   p.channels = int(proto::channelCount(frame.format));
-  const std::size_t size = std::size_t(frame.width) * frame.height * std::size_t(p.channels);
-  switch (frame.compression) {
-    case proto::Compression::kNone:
-      if (frame.pixels.size() != size) malformed("uncompressed pixel count does not match the size");
-      p.bytes = frame.pixels;
-      return p;
-    case proto::Compression::kZlib: {
-      // Inflate into exactly `size` bytes; a stream that wants more, or ends
-      // early, is malformed (docs/protocol.md: the receiver must stop there).
-      p.bytes.resize(size);
-      z_stream z{};
-      if (inflateInit(&z) != Z_OK) malformed("zlib cannot start");
-      z.next_in = const_cast<Bytef*>(frame.pixels.data());
-      z.avail_in = uInt(frame.pixels.size());
-      z.next_out = p.bytes.data();
-      z.avail_out = uInt(size);
-      const int rc = inflate(&z, Z_FINISH);
-      const std::size_t produced = size - z.avail_out;
-      inflateEnd(&z);
-      if (rc != Z_STREAM_END || produced != size) malformed("the zlib stream does not inflate to width x height pixels");
-      return p;
-    }
-    case proto::Compression::kRle:
-      break;
-  }
-  throw TclError({"PVR", "PROTOCOL", "UNSUPPORTED"},
-                 "image frame uses RLE compression, which pvrsh does not decode for 8-bit frames (zlib and none are "
-                 "supported)");
+  p.bytes = std::move(std::get<std::vector<std::uint8_t>>(decoded));
+  return p;
 }
 
 void writePng(const Pixels& pixels, const std::string& path) {

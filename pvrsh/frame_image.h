@@ -20,11 +20,10 @@ struct Pixels {
   std::vector<std::uint8_t> bytes;
 };
 
-// The pixels of an ImageFrame. Compression none and zlib are decoded; the
-// zlib stream is inflated into exactly width * height * channels bytes and
-// must end there. RLE (the renderer's float image codec) is not an 8-bit
-// format this client reads: TclError {PVR PROTOCOL UNSUPPORTED}. Damaged
-// data: {PVR PROTOCOL MALFORMED_PAYLOAD}.
+// The pixels of an ImageFrame, decoded by the protocol's pixel codec
+// (proto::decompressPixels: none, RLE or zlib, into exactly width * height *
+// channels bytes). A frame it refuses throws TclError {PVR PROTOCOL <code>}
+// with the codec's text (MALFORMED_PAYLOAD for damaged pixels).
 Pixels decodePixels(const proto::ImageFrame& frame);
 
 // Writes `pixels` as an 8-bit PNG (colour type 2 or 6, no filtering, zlib

@@ -1,5 +1,6 @@
 // No length read off the wire sizes an allocation before the bytes it
-// describes have arrived. This executable replaces the global operator new
+// describes have arrived (or, for pixels, before they are known to cover the
+// image). This executable replaces the global operator new
 // to record the largest single allocation made while a probe is open.
 #include <catch2/catch.hpp>
 
@@ -87,6 +88,48 @@ TEST_CASE("lengths inside a payload are checked before anything is sized from th
   for (const auto& frame : frames) {
     DecodeResult result;
     const std::size_t largest = largestAllocationDuring([&] { result = decodeFrame(frame); });
+    REQUIRE(std::holds_alternative<ProtocolError>(result));
+    CHECK(std::get<ProtocolError>(result).code == ErrorCode::kMalformedPayload);
+    CHECK(largest < 1024);
+  }
+}
+
+TEST_CASE("the relay hands out a complete ImageFrame without copying its pixels") {
+  // All but the last two bytes arrive, then one more: the buffer has grown
+  // to the whole frame. The last byte completes it: the decoder now
+  // allocates the pixel array; the relay hands out the bytes it holds and
+  // allocates nothing of that size.
+  ImageFrame image{0, 512, 512, PixelFormat::kRgba8, Compression::kNone, {}, std::vector<std::uint8_t>(512 * 512 * 4, 9)};
+  const auto frame = encode(image, 1, kFlagFinal);
+  const auto allButLast = [&](auto& receiver) {
+    receiver.feed(std::span(frame).first(frame.size() - 2));
+    receiver.feed(std::span(frame).subspan(frame.size() - 2, 1));
+  };
+  FrameRelay relay;
+  allButLast(relay);
+  std::optional<RelayItem> item;
+  const std::size_t largest = largestAllocationDuring([&] {
+    relay.feed(std::span(frame).last(1));
+    item = relay.pop();
+  });
+  REQUIRE(item);
+  REQUIRE(std::holds_alternative<RelayedFrame>(*item));
+  CHECK(std::get<RelayedFrame>(*item).bytes == frame);
+  CHECK(largest < 1024);
+
+  FrameDecoder decoder;
+  allButLast(decoder);
+  const std::size_t decoderLargest = largestAllocationDuring([&] { decoder.feed(std::span(frame).last(1)); });
+  CHECK(decoderLargest >= image.pixels.size());  // the probe would see a copy
+}
+
+TEST_CASE("the pixel decoder refuses a tiny stream claiming a large image before allocating the image") {
+  // 4096 x 4096 RGB passes the image limits (48 MiB); a few bytes cannot be it.
+  ImageFrame rle{0, 4096, 4096, PixelFormat::kRgb8, Compression::kRle, {}, {255, 1, 2, 3, 255, 1, 2, 3}};
+  ImageFrame zlib{0, 4096, 4096, PixelFormat::kRgb8, Compression::kZlib, {}, {0x78, 0x01, 1, 2, 3, 4, 5, 6}};
+  for (const ImageFrame& frame : {rle, zlib}) {
+    std::variant<std::vector<std::uint8_t>, ProtocolError> result;
+    const std::size_t largest = largestAllocationDuring([&] { result = decompressPixels(frame); });
     REQUIRE(std::holds_alternative<ProtocolError>(result));
     CHECK(std::get<ProtocolError>(result).code == ErrorCode::kMalformedPayload);
     CHECK(largest < 1024);

@@ -1,5 +1,6 @@
 // pvrd with real processes on an ephemeral loopback port: a real mpirun job
-// renders, clients vanish, ranks die, hostile clients come and go, SIGTERM.
+// renders, clients vanish, ranks die, hostile clients come and go, SIGTERM;
+// a fake master (fake_master.h) sends frames pvrd must refuse.
 #include <catch2/catch.hpp>
 
 #include <arpa/inet.h>
@@ -19,6 +20,7 @@
 #include <thread>
 
 #include "auth.h"
+#include "fake_master.h"
 #include "pvr_protocol.h"
 
 namespace fs = std::filesystem;
@@ -131,6 +133,33 @@ struct Daemon {
   ~Daemon() { stop(); }
 };
 
+// Everything a peer sent until it closed the connection (or `seconds` passed).
+struct Replies {
+  std::vector<proto::Decoded> messages;
+  std::optional<proto::ProtocolError> error;  // the replies did not decode
+  bool closed = false;
+};
+
+Replies readUntilClosed(int fd, double seconds) {
+  Replies replies;
+  proto::FrameDecoder decoder;
+  const auto t = Clock::now();
+  while (since(t) < seconds) {
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, 100) <= 0) continue;
+    std::uint8_t buf[65536];
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n <= 0) {
+      replies.closed = true;
+      break;
+    }
+    decoder.feed(std::span(buf, std::size_t(n)));
+    while (auto d = decoder.pop()) replies.messages.push_back(std::move(*d));
+  }
+  replies.error = decoder.error() ? decoder.error() : decoder.endOfStream();
+  return replies;
+}
+
 int connectTo(int port) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in a{};
@@ -213,7 +242,7 @@ struct Client {
 
 }  // namespace
 
-TEST_CASE("a session starts an MPI job that renders a frame; bad dataset names are refused") {
+TEST_CASE("a session starts an MPI job that renders a frame, and bad dataset names are refused") {
   Daemon d(makeDataDir("render"));
   Client c(d.port);
   c.hello();
@@ -264,21 +293,25 @@ TEST_CASE("kill -9 of a rank gives the client an Error and the daemon serves on"
   again.renderAndCheck();
 }
 
-TEST_CASE("200 hostile connections in a row, then a normal session succeeds") {
-  Daemon d(makeDataDir("hostile"));
+TEST_CASE("200 hostile connections in a row each get their exact reply, then a normal session succeeds") {
+  // Enough sessions that handlers not yet reaped never refuse the next one.
+  Daemon d(makeDataDir("hostile"), {"--max-sessions", "16"});
   std::mt19937 rng(42);
-  int survived = 0;
   for (int i = 0; i < 200; ++i) {
     const int fd = connectTo(d.port);
     std::vector<std::uint8_t> bytes;
+    std::optional<proto::ErrorCode> expected;  // none: closed without a word
     switch (i % 5) {
-      case 0:  // garbage
+      case 0:  // garbage, whose first byte is not the magic's
         bytes.resize(1 + rng() % 200);
         for (auto& b : bytes) b = std::uint8_t(rng());
+        if (bytes[0] == proto::kMagic[0]) bytes[0] = 'G';
+        expected = proto::ErrorCode::kBadMagic;
         break;
-      case 1: {  // half a frame
+      case 1: {  // half a frame, then the end of the stream
         const auto frame = proto::encode(proto::Hello{"half a frame of hello"}, 1);
         bytes.assign(frame.begin(), frame.begin() + std::ptrdiff_t(1 + rng() % (frame.size() - 1)));
+        expected = proto::ErrorCode::kTruncatedFrame;
         break;
       }
       case 2:  // idle, then closed
@@ -286,24 +319,114 @@ TEST_CASE("200 hostile connections in a row, then a normal session succeeds") {
       case 3:  // wrong magic
         bytes = proto::encode(proto::Hello{"x"}, 1);
         bytes[1] = 'Q';
+        expected = proto::ErrorCode::kBadMagic;
         break;
       case 4: {  // absurd length
         bytes = proto::encode(proto::SetScene{"a", "b"}, 1);
         bytes[12] = bytes[13] = bytes[14] = bytes[15] = 0xff;
+        expected = proto::ErrorCode::kFrameTooLarge;
         break;
       }
     }
-    if (!bytes.empty()) ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+    if (!bytes.empty()) REQUIRE(::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL) == ssize_t(bytes.size()));
+    ::shutdown(fd, SHUT_WR);  // the end of the stream; the reply can still be read
+    const Replies replies = readUntilClosed(fd, 30);
     ::close(fd);
-    ++survived;
+    INFO("connection " << i << " (case " << i % 5 << "), " << bytes.size() << " bytes sent");
+    REQUIRE(replies.closed);
+    REQUIRE_FALSE(replies.error);
+    if (!expected) {
+      CHECK(replies.messages.empty());
+      continue;
+    }
+    // Exactly an Error with the decoder's code, then Close; both about the
+    // connection (request id 0) and FINAL; then the socket closes.
+    REQUIRE(replies.messages.size() == 2);
+    const auto* error = std::get_if<proto::ErrorMessage>(&replies.messages[0].message);
+    REQUIRE(error);
+    CHECK(error->code == *expected);
+    CHECK(replies.messages[0].info == proto::FrameInfo{0, proto::kFlagFinal});
+    CHECK(std::holds_alternative<proto::Close>(replies.messages[1].message));
+    CHECK(replies.messages[1].info.requestId == 0);
   }
-  WARN("hostile connections made: " << survived);
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
   Client c(d.port);
   c.hello();
   c.openSession();
   c.renderAndCheck();
   c.send(proto::Close{""});
+}
+
+TEST_CASE("frames the master sends over the limits are refused with an Error naming the limit, and the session serves on") {
+  namespace fake = pvr::daemon::testing;
+  Daemon d(makeDataDir("relay"), {"--mpirun", FAKE_MASTER_PATH});
+  Client c(d.port);
+  c.hello();
+  c.openSession();
+  const auto script = [&](std::string_view name) {
+    c.send(proto::SetScene{"", std::string(name)});
+    // Ok, and nothing before it: the dropped rest of a refused request never arrives.
+    c.expect<proto::Ok>();
+  };
+  // The one answer to a RenderFrame under script `name`, FINAL for its request.
+  const auto render = [&](std::string_view name) {
+    script(name);
+    const auto id = c.send(proto::RenderFrame{});
+    auto d = c.next();
+    REQUIRE(d);
+    CHECK(d->info == proto::FrameInfo{id, proto::kFlagFinal});
+    return std::move(*d);
+  };
+  const auto refusal = [&](std::string_view name) {
+    const auto d = render(name);
+    REQUIRE(std::holds_alternative<proto::ErrorMessage>(d.message));
+    return std::get<proto::ErrorMessage>(d.message);
+  };
+  const auto renderGood = [&] {
+    const auto d = render(fake::kScriptGood);
+    REQUIRE(std::holds_alternative<proto::ImageFrame>(d.message));
+    // Relayed as the master sent it: equal messages encode to equal bytes.
+    const auto id = d.info.requestId;
+    CHECK(proto::encode(d.message, id, proto::kFlagFinal) == proto::encode(fake::fakeGoodFrame(), id, proto::kFlagFinal));
+  };
+  renderGood();
+
+  SECTION("an ImageFrame payload over the frame limit") {
+    const auto e = refusal(fake::kScriptOversize);
+    CHECK(e.code == proto::ErrorCode::kFrameTooLarge);
+    CHECK_THAT(e.text, Catch::StartsWith("pvrd refused the rendering job's ImageFrame: frame too large: "));
+    CHECK_THAT(e.text, Catch::Contains("ImageFrame payload of " + std::to_string(proto::kMaxFrameBytes - 15) +
+                                       " bytes exceeds the limit of " + std::to_string(proto::kMaxFrameBytes - 16)));
+  }
+  SECTION("an ImageFrame whose pixel count disagrees with its size") {
+    const auto e = refusal(fake::kScriptInconsistent);
+    CHECK(e.code == proto::ErrorCode::kMalformedPayload);
+    CHECK_THAT(e.text, Catch::Contains("needs 12 pixel bytes, got 11"));
+  }
+  renderGood();
+  c.send(proto::Close{"done"});
+  CHECK(c.expect<proto::Close>().reason == "bye");
+  CHECK(secondsUntilJobGone(d.dataDir, 2) >= 0);
+}
+
+TEST_CASE("bytes from the master that are no frame end the job with an Error, and pvrd serves on") {
+  Daemon d(makeDataDir("garbage"), {"--mpirun", FAKE_MASTER_PATH});
+  {
+    Client c(d.port);
+    c.hello();
+    c.openSession();
+    c.send(proto::SetScene{"", std::string(pvr::daemon::testing::kScriptGarbage)});
+    c.expect<proto::Ok>();
+    c.send(proto::RenderFrame{});
+    const auto e = c.expectError(10);
+    CHECK(e.code == proto::ErrorCode::kRankFailed);
+    CHECK_THAT(e.text, Catch::Contains("bad frame from the master") && Catch::Contains("bad magic"));
+    CHECK(c.expect<proto::Close>(5).reason.size() > 0);
+    CHECK(secondsUntilJobGone(d.dataDir, 3) >= 0);
+  }
+  Client again(d.port);
+  again.hello();
+  again.send(proto::CatalogRequest{});
+  CHECK(again.expect<proto::CatalogReply>().datasets.size() == 1);
 }
 
 TEST_CASE("a malformed client frame gets an Error with the decoder's code and a Close") {

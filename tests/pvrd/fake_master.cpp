@@ -1,0 +1,105 @@
+// The fake MPI job of fake_master.h. pvrd calls it as
+//   fake_master --oversubscribe ... -np N NODE --server --connect HOST:PORT --data-dir DIR
+// It serves one connection and exits when it closes.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "fake_master.h"
+
+namespace proto = pvr::proto;
+using namespace pvr::daemon::testing;
+
+namespace {
+
+int gSocket = -1;
+
+void sendBytes(std::span<const std::uint8_t> bytes) {
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::send(gSocket, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
+    if (n <= 0) std::exit(0);  // pvrd went away
+    done += std::size_t(n);
+  }
+}
+
+void send(const proto::Message& m, std::uint32_t id, bool final = true) {
+  sendBytes(proto::encode(m, id, final ? proto::kFlagFinal : 0));
+}
+
+void render(const std::string& script, std::uint32_t id) {
+  if (script == kScriptOversize) {
+    const std::uint32_t over = proto::kMaxFrameBytes - proto::kHeaderBytes + 1;
+    std::vector<std::uint8_t> header(proto::kHeaderBytes);
+    proto::writeHeader({proto::kProtocolVersion, proto::ImageFrame::kWire.type, 0, id, over},
+                       std::span(header).first<proto::kHeaderBytes>());
+    sendBytes(header);
+    const std::vector<std::uint8_t> chunk(1 << 20, 0x5A);
+    for (std::uint32_t left = over; left > 0;) {
+      const std::uint32_t n = std::min<std::uint32_t>(left, std::uint32_t(chunk.size()));
+      sendBytes(std::span(chunk).first(n));
+      left -= n;
+    }
+    send(fakeGoodFrame(), id);
+  } else if (script == kScriptInconsistent) {
+    proto::ImageFrame frame{0, 2, 2, proto::PixelFormat::kRgb8, proto::Compression::kNone, {},
+                            std::vector<std::uint8_t>(11, 1)};
+    send(frame, id);
+  } else if (script == kScriptGarbage) {
+    const std::string text = "GARBAGE, NOT A FRAME";
+    sendBytes(std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+  } else {
+    send(fakeGoodFrame(), id);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string connect;
+  for (int i = 1; i + 1 < argc; ++i)
+    if (std::string(argv[i]) == "--connect") connect = argv[i + 1];
+  const auto colon = connect.rfind(':');
+  if (colon == std::string::npos) {
+    std::fprintf(stderr, "fake_master: no --connect HOST:PORT\n");
+    return 2;
+  }
+  gSocket = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(std::uint16_t(std::atoi(connect.c_str() + colon + 1)));
+  ::inet_pton(AF_INET, connect.substr(0, colon).c_str(), &a.sin_addr);
+  if (::connect(gSocket, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+    std::perror("fake_master: connect");
+    return 1;
+  }
+  proto::FrameDecoder decoder;
+  std::string script(kScriptGood);
+  std::vector<std::uint8_t> buf(65536);
+  for (;;) {
+    const ssize_t n = ::read(gSocket, buf.data(), buf.size());
+    if (n <= 0) return 0;
+    decoder.feed(std::span(buf.data(), std::size_t(n)));
+    while (auto d = decoder.pop()) {
+      const std::uint32_t id = d->info.requestId;
+      if (const auto* open = std::get_if<proto::SessionOpen>(&d->message)) {
+        send(proto::SessionReady{open->rankCount, {}}, id);
+      } else if (const auto* scene = std::get_if<proto::SetScene>(&d->message)) {
+        script = scene->sceneJson;
+        send(proto::Ok{}, id);
+      } else if (std::holds_alternative<proto::RenderFrame>(d->message)) {
+        render(script, id);
+      } else if (std::holds_alternative<proto::Close>(d->message)) {
+        return 0;
+      } else {
+        send(proto::ErrorMessage{proto::ErrorCode::kUnsupported, "the fake master does not serve this"}, id);
+      }
+    }
+    if (decoder.error()) return 1;
+  }
+}
