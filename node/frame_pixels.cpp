@@ -23,22 +23,4 @@ void setFramePixels(proto::ImageFrame& out, const core::Image& frame, const std:
   proto::setPixels(out, srgbPixels(frame, background, out.format), wanted);
 }
 
-std::vector<std::uint8_t> framePixels(const core::Image& frame, const std::array<double, 4>& background,
-                                      proto::PixelFormat format, proto::Compression compression) {
-  return proto::compressPixels(srgbPixels(frame, background, format), format, compression);
-}
-
-std::vector<std::uint8_t> decompressPixels(const std::vector<std::uint8_t>& bytes, std::size_t expected,
-                                           proto::PixelFormat format, proto::Compression compression) {
-  proto::ImageFrame frame;
-  frame.width = std::uint32_t(expected / proto::channelCount(format));
-  frame.height = 1;
-  frame.format = format;
-  frame.compression = compression;
-  frame.pixels = bytes;
-  auto decoded = proto::decompressPixels(frame);
-  if (auto* error = std::get_if<proto::ProtocolError>(&decoded)) throw Error(ErrorCode::kBadFile, error->text);
-  return std::move(std::get<std::vector<std::uint8_t>>(decoded));
-}
-
 }  // namespace pvr::node

@@ -24,14 +24,4 @@ std::vector<std::uint8_t> srgbPixels(const core::Image& frame, const std::array<
 void setFramePixels(proto::ImageFrame& out, const core::Image& frame, const std::array<double, 4>& background,
                     proto::Compression wanted);
 
-// Transitional, for callers outside this file's owner (node/actions/
-// collect.cpp, tests/node) until they use setFramePixels and
-// proto::decompressPixels of an ImageFrame; remove then. framePixels compresses with exactly
-// `compression` (no fallback); decompressPixels is proto::decompressPixels of
-// a one-row image of `expected` bytes and throws pvr::Error (kBadFile).
-std::vector<std::uint8_t> framePixels(const core::Image& frame, const std::array<double, 4>& background,
-                                      proto::PixelFormat format, proto::Compression compression);
-std::vector<std::uint8_t> decompressPixels(const std::vector<std::uint8_t>& bytes, std::size_t expected,
-                                           proto::PixelFormat format, proto::Compression compression);
-
 }  // namespace pvr::node

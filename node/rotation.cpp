@@ -19,14 +19,12 @@ core::Vec3 turn(const core::Vec3& v, const core::Vec3& k, double angle) {
 
 Rotation::Rotation(const core::CameraSpec& base, const proto::RenderRotation& r)
     : base_(base), start_(r.start), stepsPerTurn_(r.stepsPerTurn) {
-  if (r.stepsPerTurn == 0 || r.end < r.start || std::int64_t(r.end) - r.start >= kMaxRotationFrames)
-    throw Error(ErrorCode::kInvalidArgument, "rotation needs start <= end, stepsPerTurn >= 1 and at most " +
-                                                 std::to_string(kMaxRotationFrames) + " frames");
-  const double length = std::sqrt(r.axis[0] * r.axis[0] + r.axis[1] * r.axis[1] + r.axis[2] * r.axis[2]);
-  if (!(length > 0) || !std::isfinite(length))
-    throw Error(ErrorCode::kInvalidArgument, "rotation axis must be finite and not zero");
+  if (const auto refusal = r.check(proto::Limits{}))
+    throw Error(ErrorCode::kInvalidArgument, "rotation: " + refusal->text);
+  // check() guarantees this length is finite and nonzero.
+  const double length = std::hypot(r.axis[0], r.axis[1], r.axis[2]);
   axis_ = {r.axis[0] / length, r.axis[1] / length, r.axis[2] / length};
-  frames_ = int(std::int64_t(r.end) - r.start + 1);
+  frames_ = int(r.frameCount());
 }
 
 core::CameraSpec Rotation::camera(int index) const {

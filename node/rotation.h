@@ -11,15 +11,11 @@
 
 namespace pvr::node {
 
-// The most frames one rotation may ask for.
-constexpr std::int64_t kMaxRotationFrames = 100000;
-
 class Rotation {
  public:
-  // Throws pvr::Error (kInvalidArgument) for a request no rotation answers:
-  // stepsPerTurn 0, end before start, more than kMaxRotationFrames frames,
-  // a zero or non-finite axis. (protocol's RenderRotation::check will hold
-  // this rule once it exists; this check then goes.)
+  // Throws pvr::Error (kInvalidArgument) for a request that fails
+  // proto::RenderRotation::check, the one rule (decoding already enforces
+  // it on the wire; this guards requests built in-process).
   Rotation(const core::CameraSpec& base, const proto::RenderRotation& request);
   int frames() const { return frames_; }
   // Frame `index` of the request (0 .. frames() - 1).

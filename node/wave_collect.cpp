@@ -54,8 +54,7 @@ void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFram
       out.width = std::uint32_t(width);
       out.height = std::uint32_t(height);
       out.format = state.settings.format;
-      out.compression = state.settings.compression;
-      out.pixels = framePixels(frame, state.scene.image.background, out.format, out.compression);
+      setFramePixels(out, frame, state.scene.image.background, state.settings.compression);
       out.timing.distribute = s == 0 ? times[0] + state.commandSeconds : 0.0;
       out.timing.render = times[s * 4 + 1];
       out.timing.composite = times[s * 4 + 2];

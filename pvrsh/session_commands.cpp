@@ -217,18 +217,8 @@ int setCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
 // The rules of a rotation request are the protocol's (contract C6): its
 // decoders enforce them, and pvrsh asks the same check before sending so
 // that a bad request is an error of the command that made it.
-// MERGE(C6): this branch predates RenderRotation::check; once protocol has
-// it, the body below is exactly
-//   if (const auto error = r.check(proto::Limits{}))
-//     argsError("ROTATION", "render rotate: " + error->text);
-// and the interim rules (with their magic 100000) are deleted.
 void checkRotation(const proto::RenderRotation& r) {
-  const auto refuse = [](const std::string& why) { argsError("ROTATION", "render rotate: " + why); };
-  if (r.stepsPerTurn < 1) refuse("a turn needs at least one step");
-  if (r.end < r.start) refuse("END must not be below START");
-  if (std::int64_t(r.end) - r.start >= 100000) refuse("at most 100000 frames per request");
-  const double length = std::sqrt(r.axis[0] * r.axis[0] + r.axis[1] * r.axis[1] + r.axis[2] * r.axis[2]);
-  if (!(length > 0) || !std::isfinite(length)) refuse("the axis must be finite and not 0,0,0");
+  if (const auto error = r.check(proto::Limits{})) argsError("ROTATION", "render rotate: " + error->text);
 }
 
 // :s render rotate|rotation X,Y,Z S,E:N  |  :s render frame
@@ -266,7 +256,7 @@ int renderCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   r.end = std::int32_t(parseInteger("-end", range.substr(comma + 1, colon - comma - 1), INT32_MIN, INT32_MAX));
   r.stepsPerTurn = std::uint32_t(parseInteger("-steps", range.substr(colon + 1), 0, UINT32_MAX));
   checkRotation(r);
-  const auto frames = std::uint32_t(std::int64_t(r.end) - r.start + 1);
+  const std::uint32_t frames = r.frameCount();
   s.render(r, frames, "rotate " + axisText + " " + range);
   Tcl_SetObjResult(interp, Tcl_NewWideIntObj(frames));
   return TCL_OK;

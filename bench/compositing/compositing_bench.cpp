@@ -119,12 +119,12 @@ void benchSize(const Args& args, core::Scene scene, int size, comm::Communicator
     }
 }
 
-// Voxel bytes per rank against (1/n) of the volume, for both decompositions.
+// Voxel bytes per rank against (1/n) of the volume, for every decomposition.
 void benchMemory(const Args& args, core::Scene scene, comm::Communicator& comm) {
   scene.image.width = scene.image.height = 64;  // the rendering is not the point here
-  for (auto decomposition : {node::Decomposition::kKd, node::Decomposition::kBalanced}) {
+  for (const auto& entry : node::decompositions()) {
     node::FrameOptions options;
-    options.decomposition = decomposition;
+    options.decomposition = entry.value;
     const node::FrameResult r = node::renderFrame(scene, options, comm);
     if (comm.rank() != 0) continue;
     std::uint64_t mx = 0, mn = ~0ull, sum = 0;
@@ -137,7 +137,7 @@ void benchMemory(const Args& args, core::Scene scene, comm::Communicator& comm) 
     std::ofstream out = appendCsv(args.memoryCsv,
                                   "ranks,decomposition,max_brick_bytes,mean_brick_bytes,min_brick_bytes,"
                                   "volume_bytes,volume_over_n,ghost_layers,max_over_share");
-    out << comm.size() << ',' << (decomposition == node::Decomposition::kKd ? "kd" : "balanced") << ','
+    out << comm.size() << ',' << entry.name << ','
         << mx << ',' << sum / n << ',' << mn << ',' << r.volumeBytes << ',' << r.volumeBytes / n << ','
         << r.ghostLayers << ',' << mx / (r.volumeBytes / n) << '\n';
   }

@@ -15,7 +15,7 @@ TEST_CASE("an empty layout is one render cluster of every rank, rank 0 included"
   CHECK(l.groups == 1);
 }
 
-TEST_CASE("two clusters of one group split the scanlines; two groups take alternate frames") {
+TEST_CASE("two clusters of one group split the scanlines, two groups take alternate frames") {
   const auto band = node::makeLayout({{ClusterRole::kRender, 2, 0}, {ClusterRole::kRender, 2, 0}}, 4);
   CHECK(band.groups == 1);
   CHECK(band.clusters[1].band == 1);
@@ -54,16 +54,38 @@ TEST_CASE("bands cover every row once") {
   CHECK(next == 64);
 }
 
-TEST_CASE("RLE and zlib frames decode to the uncompressed pixels") {
+TEST_CASE("the collector's frames decode to its sRGB pixels, compressed only when that pays") {
   core::Image image = core::Image::fullFrame(7, 5);
   image.at(3, 2) = {0.5f, 0.25f, 0.125f, 0.5f};
   const std::array<double, 4> background{0.1, 0.2, 0.3, 1};
   for (auto format : {proto::PixelFormat::kRgb8, proto::PixelFormat::kRgba8}) {
-    const auto raw = node::framePixels(image, background, format, proto::Compression::kNone);
+    const auto raw = node::srgbPixels(image, background, format);
     REQUIRE(raw.size() == 7 * 5 * proto::channelCount(format));
-    for (auto c : {proto::Compression::kRle, proto::Compression::kZlib}) {
-      const auto packed = node::framePixels(image, background, format, c);
-      CHECK(node::decompressPixels(packed, raw.size(), format, c) == raw);
+    for (auto c : {proto::Compression::kNone, proto::Compression::kRle, proto::Compression::kZlib}) {
+      proto::ImageFrame f;
+      f.width = 7;
+      f.height = 5;
+      f.format = format;
+      node::setFramePixels(f, image, background, c);
+      // A flat frame with one odd pixel compresses, so the wanted code is kept.
+      CHECK(f.compression == c);
+      const auto decoded = proto::decompressPixels(f);
+      REQUIRE(std::holds_alternative<std::vector<std::uint8_t>>(decoded));
+      CHECK(std::get<std::vector<std::uint8_t>>(decoded) == raw);
     }
   }
+  // Noise does not compress: the frame goes out raw.
+  core::Image noise = core::Image::fullFrame(16, 16);
+  std::uint32_t seed = 12345;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      const auto next = [&] { return float((seed = seed * 1664525u + 1013904223u) >> 8) / float(1 << 24); };
+      noise.at(x, y) = {next(), next(), next(), 1.0f};
+    }
+  proto::ImageFrame f;
+  f.width = f.height = 16;
+  f.format = proto::PixelFormat::kRgb8;
+  node::setFramePixels(f, noise, background, proto::Compression::kRle);
+  CHECK(f.compression == proto::Compression::kNone);
+  CHECK(f.pixels == node::srgbPixels(noise, background, f.format));
 }

@@ -19,7 +19,7 @@ core::CameraSpec camera() {
 
 }  // namespace
 
-TEST_CASE("eye and up turn about look_at; frame k of a request starting at s is step s + k") {
+TEST_CASE("eye and up turn about look_at, frame k of a request starting at s is step s + k") {
   // Quarter turns about +z: the eye goes from -y to +x of look_at; up stays.
   const node::Rotation r(camera(), {{0, 0, 2}, 1, 3, 4});
   REQUIRE(r.frames() == 3);
@@ -41,7 +41,7 @@ TEST_CASE("a rotation no frames answer is refused") {
   CHECK_THROWS_AS(node::Rotation(camera(), {{0, 1, 0}, 0, 5, 0}), Error);
   CHECK_THROWS_AS(node::Rotation(camera(), {{0, 1, 0}, 5, 4, 10}), Error);
   CHECK_THROWS_AS(node::Rotation(camera(), {{0, 0, 0}, 0, 1, 10}), Error);
-  CHECK_THROWS_AS(node::Rotation(camera(), {{0, 1, 0}, 0, std::int32_t(node::kMaxRotationFrames), 10}), Error);
-  CHECK(node::Rotation(camera(), {{0, 1, 0}, 0, std::int32_t(node::kMaxRotationFrames) - 1, 10}).frames() ==
-        node::kMaxRotationFrames);
+  CHECK_THROWS_AS(node::Rotation(camera(), {{0, 1, 0}, 0, std::int32_t(proto::kMaxRotationFrames), 10}), Error);
+  CHECK(node::Rotation(camera(), {{0, 1, 0}, 0, std::int32_t(proto::kMaxRotationFrames) - 1, 10}).frames() ==
+        int(proto::kMaxRotationFrames));
 }

@@ -77,7 +77,7 @@ TEST_CASE("an image that does not fit a frame in the session's pixel format is r
   refused(big, {"", R"({"runtime": {"pixels": "rgba8"}})"});
 }
 
-TEST_CASE("datasets resolve inside the data directory; volume files in the JSON are refused") {
+TEST_CASE("datasets resolve inside the data directory, volume files in the JSON are refused") {
   CHECK(refused({}, {"../etc/passwd", ""}).code == proto::ErrorCode::kDatasetNotFound);
   CHECK(refused({}, {"missing.json", ""}).code == proto::ErrorCode::kDatasetNotFound);
   CHECK_THAT(refused({}, {"", R"({"volume": {"file": "/etc/passwd"}})"}).text, Catch::Contains("volume.file"));

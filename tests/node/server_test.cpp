@@ -361,7 +361,9 @@ TEST_CASE_METHOD(Fixture, "clusters, groups and a compositing cluster all render
     REQUIRE(std::holds_alternative<proto::ImageFrame>(d->message));
     const auto& f = std::get<proto::ImageFrame>(d->message);
     CHECK(f.format == proto::PixelFormat::kRgb8);
-    CHECK(node::decompressPixels(f.pixels, 64 * 64 * 3, f.format, f.compression).size() == 64 * 64 * 3);
+    const auto decoded = proto::decompressPixels(f);
+    REQUIRE(std::holds_alternative<std::vector<std::uint8_t>>(decoded));
+    CHECK(std::get<std::vector<std::uint8_t>>(decoded).size() == 64 * 64 * 3);
     const Reference narrowRef(nlohmann::json::parse(narrow));
     CHECK(core::maxAbsDifference(dumped(job, id, 0), narrowRef.frame(0, 1)) <= 1e-5);
   }

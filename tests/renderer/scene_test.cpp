@@ -156,7 +156,7 @@ TEST_CASE("a scene with only a volume takes the defaults of scene.h", "[scene]")
   CHECK(s.transfer.points[1].opacity == 1);
 }
 
-TEST_CASE("a camera section turns the automatic camera off; perspective fov defaults to 30", "[scene]") {
+TEST_CASE("a camera section turns the automatic camera off, perspective fov defaults to 30", "[scene]") {
   json doc = baseDoc();
   doc["camera"] = json::parse(R"({"eye": [1, 2, 3], "look_at": [0, 0, 0]})");
   const Scene s = parseScene(doc, "");

@@ -32,7 +32,7 @@ TEST_CASE("procedural grids span [-1,1] on the longest axis, centred at 0", "[io
   CHECK(point->readAll().valueAt({0, 0, 0}) == 1.0);
 }
 
-TEST_CASE("procedural values lie in [0,1]; the constant slab is 1 everywhere", "[io]") {
+TEST_CASE("procedural values lie in [0,1], the constant slab is 1 everywhere", "[io]") {
   for (const std::string& name : proceduralNames()) {
     INFO(name);
     const Brick b = openProcedural(name, {24, 20, 16})->readAll();

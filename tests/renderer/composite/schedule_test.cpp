@@ -146,7 +146,7 @@ TEST_CASE("radix-k groups cover log2(k) bits per round, the last takes the rest"
   CHECK_THROWS_AS(radixKSchedule(swap, 0, 1), pvr::Error);
 }
 
-TEST_CASE("halving regions tiles the frame; final tiles are disjoint and cover it", "[schedule]") {
+TEST_CASE("halving regions tiles the frame, final tiles are disjoint and cover it", "[schedule]") {
   const PixelRect frame{0, 0, 37, 23};
   for (int rounds = 0; rounds <= 5; ++rounds) {
     long area = 0;
