@@ -1,6 +1,9 @@
 #include "wave_collect.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstring>
+#include <span>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -22,22 +25,47 @@ void dumpFloat(const std::string& dir, std::uint32_t request, std::uint32_t fram
   std::fclose(f);
 }
 
+// A frame's phases from every rank's: dist, rend and comp are the slowest
+// rank's; comm is the longest a rank spent in compositing messages beyond
+// waiting for a slower rank's brick (a rank that finished rendering early
+// waits in its first exchange), so the phases add up to the frame's time
+// instead of counting the render imbalance twice.
+std::vector<double> frameTimes(const std::vector<comm::Bytes>& perRank, std::size_t slots) {
+  std::vector<std::vector<double>> ranks;
+  for (const comm::Bytes& b : perRank) {
+    if (b.size() != slots * 4 * sizeof(double)) throw Error(ErrorCode::kInternal, "wave timings of the wrong size");
+    std::vector<double> t(slots * 4);
+    std::memcpy(t.data(), b.data(), b.size());
+    ranks.push_back(std::move(t));
+  }
+  std::vector<double> out(slots * 4, 0.0);
+  for (const auto& t : ranks)
+    for (std::size_t i = 0; i < out.size(); ++i)
+      if (i % 4 != 3) out[i] = std::max(out[i], t[i]);
+  for (std::size_t s = 0; s < slots; ++s)
+    for (const auto& t : ranks) {
+      const double waitForRender = out[s * 4 + 1] - t[s * 4 + 1];
+      out[s * 4 + 3] = std::max(out[s * 4 + 3], t[s * 4 + 3] - waitForRender);
+    }
+  return out;
+}
+
 }  // namespace
 
 void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame,
                  std::optional<comm::Failure>& failure) {
-  // Timings: max over ranks; slot s holds rend, comp, comm at 4s+1..4s+3,
-  // and slot 0 the distribution at 0.
+  // Timings of every rank, gathered: slot s holds rend, comp, comm at
+  // 4s+1..4s+3, and slot 0 the distribution at 0.
   const std::size_t slots = state.wave.size();
-  std::vector<double> times(slots * 4, 0.0);
+  std::vector<double> mine(slots * 4, 0.0);
   for (std::size_t s = 0; s < slots; ++s) {
-    times[s * 4 + 1] = state.wave[s].rend;
-    times[s * 4 + 2] = state.wave[s].comp;
-    times[s * 4 + 3] = state.wave[s].comm;
+    mine[s * 4 + 1] = state.wave[s].rend;
+    mine[s * 4 + 2] = state.wave[s].comp;
+    mine[s * 4 + 3] = state.wave[s].comm;
   }
-  if (slots > 0) times[0] = state.pendingDist;
+  if (slots > 0) mine[0] = state.pendingDist;
   state.pendingDist = 0;
-  state.world.allReduceMax(times);
+  const std::vector<double> times = frameTimes(state.world.allGather(std::as_bytes(std::span(mine))), slots);
   if (state.world.rank() != 0 || failure) return;
 
   const int width = state.scene.image.width, height = state.scene.image.height;
