@@ -151,6 +151,16 @@ struct Close {
   bool operator==(const Close&) const = default;
 };
 
+// Master rank -> session handler, the first frame on the connect-back: the
+// one-time secret pvrd handed to the job in its environment, so that the
+// handler relays nothing for a connection that is not the job it launched.
+struct JobHello {
+  static constexpr WireInfo kWire{0x08, "JobHello", &Limits::maxControlPayload};
+  std::string secret;  // PVR_JOB_SECRET as the job received it
+  static auto fields(auto& self) { return std::tie(self.secret); }
+  bool operator==(const JobHello&) const = default;
+};
+
 // ---- Session and scene ----
 
 // Client -> server: start the MPI job.
@@ -158,7 +168,8 @@ struct SessionOpen {
   static constexpr WireInfo kWire{0x10, "SessionOpen", &Limits::maxControlPayload};
   std::uint32_t rankCount = 0;        // 0: the daemon's default
   std::vector<ClusterSpec> clusters;  // empty: the master's default layout
-  static auto fields(auto& self) { return std::tie(self.rankCount, self.clusters); }
+  std::string account;                // batch-system account to charge ("": the site's default)
+  static auto fields(auto& self) { return std::tie(self.rankCount, self.clusters, self.account); }
   bool operator==(const SessionOpen&) const = default;
 };
 
@@ -303,7 +314,7 @@ struct CatalogReply {
 // The message table: one line per message type. Order is free (wire type
 // numbers live in kWire); message_table.cpp checks they are unique.
 using Message = std::variant<
-    Hello, Welcome, AuthChallenge, AuthResponse, Ok, ErrorMessage, Close,
+    Hello, Welcome, AuthChallenge, AuthResponse, Ok, ErrorMessage, Close, JobHello,
     SessionOpen, SessionReady, SetScene, SetLayout,
     RenderFrame, RenderRotation, ImageFrame, Cancel,
     StatusRequest, StatusReply, PerformanceRequest, PerformanceReply, CatalogRequest, CatalogReply>;
