@@ -1,6 +1,10 @@
 #include "options.h"
 
+#include <arpa/inet.h>
+
 #include <charconv>
+
+#include "launcher.h"
 
 namespace pvr::daemon {
 namespace {
@@ -48,8 +52,31 @@ std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, 
       }
     } else if (a == "--token-file") {
       o.tokenFile = v;
+    } else if (a == "--advertise") {
+      in_addr parsed{};
+      if (::inet_pton(AF_INET, v.c_str(), &parsed) != 1) {
+        error = "--advertise takes a numeric IPv4 address, not '" + v + "'";
+        return std::nullopt;
+      }
+      o.advertise = v;
+    } else if (a == "--launcher") {
+      if (!isLauncherName(v)) {
+        error = "--launcher takes one of " + launcherNames() + ", not '" + v + "'";
+        return std::nullopt;
+      }
+      o.launcher = v;
+    } else if (a == "--partition" || a == "--time") {
+      if (v.empty()) {
+        error = a + " needs a value";
+        return std::nullopt;
+      }
+      (a == "--partition" ? o.partition : o.time) = v;
     } else if (a == "--mpirun") {
       o.mpirun = v;
+    } else if (a == "--salloc") {
+      o.salloc = v;
+    } else if (a == "--scancel") {
+      o.scancel = v;
     } else if (a == "--node") {
       o.node = v;
     } else if (a == "--idle-timeout") {
@@ -66,6 +93,15 @@ std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, 
   }
   if (o.dataDir.empty()) {
     error = "--data-dir is required";
+    return std::nullopt;
+  }
+  const bool slurm = o.launcher == "slurm";
+  if (!slurm && (!o.partition.empty() || !o.time.empty())) {
+    error = "--partition and --time need --launcher slurm";
+    return std::nullopt;
+  }
+  if (slurm && !o.hostfile.empty()) {
+    error = "--hostfile does not go with --launcher slurm: the allocation names the hosts";
     return std::nullopt;
   }
   if (!isLoopback(o.host) && o.tokenFile.empty()) {

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <map>
 
+#include "advertise.h"
 #include "auth.h"
 #include "options.h"
 #include "pvr_protocol.h"
@@ -52,14 +53,18 @@ int main(int argc, char** argv) {
   std::string error;
   const auto options = parseOptions(std::vector<std::string>(argv + 1, argv + argc), error);
   if (!options) {
-    std::fprintf(stderr, "pvrd: %s\nusage: pvrd --listen HOST:PORT --data-dir DIR [--hostfile F] [--max-ranks N] "
-                         "[--max-sessions N] [--token-file F] [--mpirun PATH] [--node PATH] [--idle-timeout S]\n",
-                 error.c_str());
+    std::fprintf(stderr, "pvrd: %s\nusage: %s\n", error.c_str(), kUsage);
     return 2;
   }
   SessionConfig config;
   config.options = &*options;
   config.nodePath = options->node.empty() ? nodeNextToSelf() : options->node;
+  config.daemonPid = ::getpid();
+  config.advertise = advertiseAddress(*options, error);
+  if (config.advertise.empty()) {
+    std::fprintf(stderr, "pvrd: %s\n", error.c_str());
+    return 2;
+  }
   if (!options->tokenFile.empty()) {
     const auto token = readToken(options->tokenFile, error);
     if (!token) {
@@ -87,7 +92,10 @@ int main(int argc, char** argv) {
   std::printf("pvrd listening on %s:%d\n", options->host.c_str(), port);
   std::fflush(stdout);
   logEvent(0, "listening on " + options->host + ":" + std::to_string(port) + ", data " + options->dataDir + ", node " +
-                  config.nodePath + (config.token.empty() ? "" : ", token required"));
+                  config.nodePath + ", launcher " + options->launcher + ", ranks connect back to " + config.advertise +
+                  (config.token.empty() ? "" : ", token required"));
+  if (options->launcher != "mpirun" && options->advertise.empty() && isLoopback(config.advertise))
+    logEvent(0, "warning: ranks on other hosts cannot reach " + config.advertise + "; give --advertise ADDR");
 
   std::map<pid_t, std::uint64_t> handlers;
   std::uint64_t nextSession = 1;

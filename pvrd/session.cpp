@@ -1,21 +1,19 @@
 #include "session.h"
 
-#include <dirent.h>
-#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cstring>
 #include <deque>
-#include <map>
-#include <regex>
+#include <memory>
+#include <optional>
 #include <set>
 
 #include "auth.h"
 #include "catalog.h"
+#include "connect_back.h"
+#include "launcher.h"
 #include "pvr_protocol.h"
 #include "sys.h"
 
@@ -27,40 +25,9 @@ using proto::ErrorCode;
 volatile sig_atomic_t gStop = 0;
 void onStop(int) { gStop = 1; }
 
+// The master rank must connect back this soon after its ranks have hosts
+// (after the launch for mpirun, after the grant for a batch allocation).
 constexpr double kMasterConnectSeconds = 60;
-constexpr std::size_t kStderrTail = 4096;
-
-// Every process descended from `root`, read from /proc.
-std::set<pid_t> descendants(pid_t root) {
-  std::multimap<pid_t, pid_t> children;
-  if (DIR* d = ::opendir("/proc")) {
-    while (dirent* e = ::readdir(d)) {
-      const pid_t pid = pid_t(std::atoi(e->d_name));
-      if (pid <= 0) continue;
-      char path[64];
-      std::snprintf(path, sizeof path, "/proc/%d/stat", pid);
-      FILE* f = std::fopen(path, "r");
-      if (!f) continue;
-      char buf[512];
-      const std::size_t n = std::fread(buf, 1, sizeof buf - 1, f);
-      std::fclose(f);
-      buf[n] = 0;
-      const char* close = std::strrchr(buf, ')');
-      int ppid = 0;
-      if (close && std::sscanf(close + 1, " %*c %d", &ppid) == 1) children.emplace(ppid, pid);
-    }
-    ::closedir(d);
-  }
-  std::set<pid_t> found;
-  std::deque<pid_t> frontier{root};
-  while (!frontier.empty()) {
-    const pid_t p = frontier.front();
-    frontier.pop_front();
-    for (auto [it, end] = children.equal_range(p); it != end; ++it)
-      if (found.insert(it->second).second) frontier.push_back(it->second);
-  }
-  return found;
-}
 
 class Session {
  public:
@@ -76,22 +43,28 @@ class Session {
   }
   void endConnection(ErrorCode code, const std::string& text, std::uint32_t id);
   void onClient(proto::Decoded frame);
+  void openSession(const proto::SessionOpen& open, std::uint32_t id);
   void onMaster(proto::RelayItem item);
+  void onMasterBytes(std::span<const std::uint8_t> bytes);
+  void adoptMaster(ConnectBack::Master master, double now);
   void refuseMasterFrame(const proto::RefusedFrame& refused);
   void forward(const proto::Message& m, std::uint32_t id);
-  bool launch(std::uint32_t ranks, std::string& error);
-  void drainStderr();
+  bool launch(std::uint32_t ranks, const std::string& account, std::string& error);
+  void onLaunchEvent(const LaunchEvent& event, double now);
+  proto::StatusReply queuedStatus() const;
   void jobEnded(const std::string& why);
   void teardown();
 
   const SessionConfig& cfg_;
   const DaemonOptions& opt_;
   int client_;
-  int master_ = -1, listen_ = -1, stderr_ = -1;
-  pid_t job_ = -1;
-  bool jobExited_ = false;
-  int jobStatus_ = 0;
-  std::string stderrTail_;
+  int master_ = -1;
+  std::unique_ptr<Launcher> launcher_;       // while a job runs
+  std::unique_ptr<ConnectBack> connectBack_;  // until the master proved itself
+  double masterDeadline_ = 0;                // 0: none (waiting in a batch queue)
+  // The SessionOpen not answered yet: queue progress and a failed launch answer it.
+  std::uint32_t openRequest_ = 0;
+  std::optional<LaunchEvent> queued_;  // the allocation request waits in a batch queue
   proto::FrameDecoder fromClient_;
   // Master frames are checked and passed on as they came, not re-encoded.
   proto::FrameRelay fromMaster_;
@@ -171,28 +144,18 @@ void Session::onClient(proto::Decoded frame) {
     sendClient(proto::Ok{}, id);
     return;
   }
+  if (std::holds_alternative<proto::JobHello>(m))
+    return replyError(ErrorCode::kUnexpectedMessage, "JobHello is the rendering job's message, not a client's", id);
   if (std::holds_alternative<proto::CatalogRequest>(m)) {
     sendClient(proto::CatalogReply{listDatasets(opt_.dataDir)}, id);
     return;
   }
-  if (const auto* open = std::get_if<proto::SessionOpen>(&m)) {
-    if (job_ > 0) return replyError(ErrorCode::kUnexpectedMessage, "a session is already open", id);
-    const std::uint32_t ranks = open->rankCount ? open->rankCount : std::uint32_t(std::min(2, opt_.maxRanks));
-    if (ranks > std::uint32_t(opt_.maxRanks))
-      return replyError(ErrorCode::kLimitExceeded,
-                        "ranks " + std::to_string(ranks) + " over --max-ranks " + std::to_string(opt_.maxRanks), id);
-    std::string error;
-    if (!launch(ranks, error)) return replyError(ErrorCode::kInternal, "cannot start the job: " + error, id);
-    forward(m, id);
+  if (const auto* open = std::get_if<proto::SessionOpen>(&m)) return openSession(*open, id);
+  if (std::holds_alternative<proto::StatusRequest>(m) && (!launcher_ || queued_)) {
+    sendClient(launcher_ ? queuedStatus() : proto::StatusReply{{{"state", "connected"}, {"session", "none"}}}, id);
     return;
   }
-  if (job_ < 0) {
-    if (std::holds_alternative<proto::StatusRequest>(m)) {
-      sendClient(proto::StatusReply{{{"state", "connected"}, {"session", "none"}}}, id);
-      return;
-    }
-    return replyError(ErrorCode::kUnexpectedMessage, "open a session first", id);
-  }
+  if (!launcher_) return replyError(ErrorCode::kUnexpectedMessage, "open a session first", id);
   if (const auto* scene = std::get_if<proto::SetScene>(&m); scene && !scene->dataset.empty()) {
     auto resolved = resolveDataset(opt_.dataDir, scene->dataset);
     if (auto* err = std::get_if<proto::ProtocolError>(&resolved)) {
@@ -204,22 +167,55 @@ void Session::onClient(proto::Decoded frame) {
   forward(m, id);
 }
 
+void Session::openSession(const proto::SessionOpen& open, std::uint32_t id) {
+  if (launcher_) return replyError(ErrorCode::kUnexpectedMessage, "a session is already open", id);
+  const std::uint32_t ranks = open.rankCount ? open.rankCount : std::uint32_t(std::min(2, opt_.maxRanks));
+  if (ranks > std::uint32_t(opt_.maxRanks))
+    return replyError(ErrorCode::kLimitExceeded,
+                      "ranks " + std::to_string(ranks) + " over --max-ranks " + std::to_string(opt_.maxRanks), id);
+  if (!isValidAccount(open.account))
+    return replyError(ErrorCode::kBadArgument,
+                      "account '" + printable(std::span(reinterpret_cast<const std::uint8_t*>(open.account.data()),
+                                                        open.account.size())) +
+                          "' may hold only A-Z a-z 0-9 _ . -",
+                      id);
+  std::string error;
+  if (!launch(ranks, open.account, error)) {
+    teardown();
+    return replyError(ErrorCode::kInternal, "cannot start the job: " + error, id);
+  }
+  openRequest_ = id;
+  forward(open, id);
+}
+
 void Session::onMaster(proto::RelayItem item) {
   if (const auto* refused = std::get_if<proto::RefusedFrame>(&item)) return refuseMasterFrame(*refused);
   const auto& frame = std::get<proto::RelayedFrame>(item);
   if (frame.header.type == proto::Close::kWire.type) return jobEnded("the master closed the session");
   const std::uint32_t id = frame.header.requestId;
+  const bool final = (frame.header.flags & proto::kFlagFinal) != 0;
+  if (final && id == openRequest_) openRequest_ = 0;
   if (refusedRequests_.count(id)) {
     // The client already has its Error for this request.
-    if (frame.header.flags & proto::kFlagFinal) refusedRequests_.erase(id);
+    if (final) refusedRequests_.erase(id);
     return;
   }
   sendClientBytes(frame.bytes);
 }
 
+void Session::onMasterBytes(std::span<const std::uint8_t> bytes) {
+  fromMaster_.feed(bytes);
+  while (auto item = fromMaster_.pop()) {
+    onMaster(std::move(*item));
+    if (done_) return;
+  }
+  if (fromMaster_.error()) jobEnded("bad frame from the master: " + fromMaster_.error()->text);
+}
+
 void Session::refuseMasterFrame(const proto::RefusedFrame& refused) {
   const std::uint32_t id = refused.header.requestId;
   const bool final = (refused.header.flags & proto::kFlagFinal) != 0;
+  if (final && id == openRequest_) openRequest_ = 0;
   const std::string what = "the rendering job's " + std::string(refused.info->name);
   log("refused " + what + " for request " + std::to_string(id) + ": " + refused.error.text);
   if (refusedRequests_.count(id)) {
@@ -231,118 +227,101 @@ void Session::refuseMasterFrame(const proto::RefusedFrame& refused) {
   if (!final && id != 0) refusedRequests_.insert(id);
 }
 
-bool Session::launch(std::uint32_t ranks, std::string& error) {
-  int port = 0;
-  listen_ = tcpListen("127.0.0.1", port, error);
-  if (listen_ < 0) return false;
-  int pipeFds[2];
-  if (::pipe2(pipeFds, O_CLOEXEC) != 0) {
-    error = errnoText("pipe2");
+void Session::adoptMaster(ConnectBack::Master master, double now) {
+  master_ = master.fd;
+  connectBack_.reset();
+  masterDeadline_ = 0;
+  log("master connected from " + master.peer + " after " + std::to_string(now - launchedAt_) + " s");
+  std::string error;
+  while (!pendingToMaster_.empty() && !done_) {
+    if (!writeAll(master_, pendingToMaster_.front(), error)) jobEnded("master write failed: " + error);
+    pendingToMaster_.pop_front();
+  }
+  if (!done_ && !master.rest.empty()) onMasterBytes(master.rest);
+}
+
+bool Session::launch(std::uint32_t ranks, const std::string& account, std::string& error) {
+  const auto secret = makeJobSecret();
+  if (!secret) {
+    error = "no random secret";
     return false;
   }
-  std::vector<std::string> args{opt_.mpirun, "--oversubscribe", "--bind-to", "none", "-np", std::to_string(ranks)};
-  if (!opt_.hostfile.empty()) args.insert(args.end(), {"--hostfile", opt_.hostfile});
-  args.insert(args.end(), {cfg_.nodePath, "--server", "--connect", "127.0.0.1:" + std::to_string(port), "--data-dir",
-                           opt_.dataDir});
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const pid_t pid = ::fork();
-  if (pid < 0) {
-    error = errnoText("fork");
-    ::close(pipeFds[0]);
-    ::close(pipeFds[1]);
-    return false;
-  }
-  if (pid == 0) {
-    ::signal(SIGTERM, SIG_DFL);
-    ::signal(SIGINT, SIG_DFL);
-    ::signal(SIGPIPE, SIG_DFL);
-    ::signal(SIGCHLD, SIG_DFL);
-    ::setpgid(0, 0);
-    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-    const int devnull = ::open("/dev/null", O_RDONLY);
-    ::dup2(devnull, 0);
-    ::dup2(pipeFds[1], 1);
-    ::dup2(pipeFds[1], 2);
-    ::close_range(3, ~0u, 0);
-    if (::geteuid() == 0) {
-      ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-      ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-    }
-    ::execvp(argv[0], argv.data());
-    const std::string msg = errnoText("exec") + " " + opt_.mpirun + "\n";
-    [[maybe_unused]] auto n = ::write(2, msg.data(), msg.size());
-    ::_exit(127);
-  }
-  ::setpgid(pid, pid);
-  ::close(pipeFds[1]);
-  stderr_ = pipeFds[0];
-  ::fcntl(stderr_, F_SETFL, O_NONBLOCK);
-  job_ = pid;
+  connectBack_ = std::make_unique<ConnectBack>(cfg_.id, *secret);
+  if (!connectBack_->listen(cfg_.advertise, error)) return false;
+  JobSpec spec{ranks,
+               cfg_.nodePath,
+               connectBack_->where(),
+               opt_.dataDir,
+               *secret,
+               account,
+               "pvr-" + std::to_string(cfg_.daemonPid) + "-" + std::to_string(cfg_.id),
+               cfg_.id};
+  launcher_ = makeLauncher(opt_);
+  if (!launcher_->start(spec, error)) return false;
   launchedAt_ = monotonicSeconds();
-  log("launched mpirun pid " + std::to_string(pid) + " with " + std::to_string(ranks) + " ranks, master port " +
-      std::to_string(port));
+  masterDeadline_ = launchedAt_ + kMasterConnectSeconds;
+  log("launched " + std::string(launcher_->program()) + " pid " + std::to_string(launcher_->pid()) + " with " +
+      std::to_string(ranks) + " ranks, master connects back to " + connectBack_->where() +
+      (account.empty() ? "" : ", account " + account));
   return true;
 }
 
-void Session::drainStderr() {
-  if (stderr_ < 0) return;
-  char buf[4096];
-  for (;;) {
-    const ssize_t n = ::read(stderr_, buf, sizeof buf);
-    if (n > 0) {
-      stderrTail_.append(buf, std::size_t(n));
-      if (stderrTail_.size() > kStderrTail) stderrTail_.erase(0, stderrTail_.size() - kStderrTail);
-      continue;
-    }
-    if (n == 0) {
-      ::close(stderr_);
-      stderr_ = -1;
-    }
-    return;
+proto::StatusReply Session::queuedStatus() const {
+  return proto::StatusReply{{{"state", "queued"}, {"batch_job", queued_->batchJob}, {"reason", queued_->reason}}};
+}
+
+void Session::onLaunchEvent(const LaunchEvent& event, double now) {
+  switch (event.kind) {
+    case LaunchEvent::Kind::kQueued:
+      // The wait for an allocation has no time limit; the client sees it.
+      queued_ = event;
+      masterDeadline_ = 0;
+      log("queued: batch job " + event.batchJob + ": " + event.reason);
+      if (openRequest_) sendClient(queuedStatus(), openRequest_, false);
+      return;
+    case LaunchEvent::Kind::kGranted:
+      if (queued_ || masterDeadline_ == 0) log("allocation " + event.batchJob + " granted");
+      queued_.reset();
+      if (master_ < 0) masterDeadline_ = now + kMasterConnectSeconds;
+      return;
+    case LaunchEvent::Kind::kLost:
+      return jobEnded(event.reason);
   }
 }
 
 void Session::jobEnded(const std::string& why) {
   if (done_) return;
-  // Give mpirun a moment to print which rank failed and exit.
+  // Give the launcher a moment to print which rank failed and exit.
   const double until = monotonicSeconds() + 1.0;
-  while (monotonicSeconds() < until && !jobExited_) {
-    drainStderr();
-    if (::waitpid(job_, &jobStatus_, WNOHANG) == job_) jobExited_ = true;
-    else ::usleep(20000);
+  while (launcher_ && monotonicSeconds() < until && !launcher_->exited()) {
+    launcher_->readOutput();
+    ::usleep(20000);
   }
-  drainStderr();
-  const int rank = rankFromMpirunStderr(stderrTail_);
-  std::string tail = stderrTail_.size() > 600 ? stderrTail_.substr(stderrTail_.size() - 600) : stderrTail_;
-  const std::string text = rank >= 0 ? "rank " + std::to_string(rank) + " failed: the rendering job ended (" + why + ")"
-                                     : "the rendering job ended unexpectedly (" + why + "): " + tail;
+  std::string text = why;
+  if (launcher_) {
+    launcher_->readOutput();
+    text = launcher_->endText(why);
+  }
   log("job ended: " + text);
+  const std::uint32_t id = openRequest_;
   teardown();
-  replyError(ErrorCode::kRankFailed, text, 0);
+  replyError(ErrorCode::kRankFailed, text, id);
   sendClient(proto::Close{"the rendering job ended"}, 0);
   done_ = true;
 }
 
 void Session::teardown() {
-  for (int* fd : {&master_, &listen_, &stderr_})
-    if (*fd >= 0) ::close(std::exchange(*fd, -1));
-  if (job_ <= 0) return;
+  if (master_ >= 0) ::close(std::exchange(master_, -1));
+  connectBack_.reset();
+  queued_.reset();
+  openRequest_ = 0;
+  masterDeadline_ = 0;
+  if (!launcher_) return;
   const double t0 = monotonicSeconds();
-  const std::set<pid_t> family = descendants(job_);
-  if (!jobExited_) ::kill(-job_, SIGTERM);
-  for (pid_t p : family) ::kill(p, SIGTERM);
-  while (!jobExited_ && monotonicSeconds() - t0 < 1.0) {
-    if (::waitpid(job_, &jobStatus_, WNOHANG) == job_) jobExited_ = true;
-    else ::usleep(10000);
-  }
-  ::kill(-job_, SIGKILL);
-  for (pid_t p : family) ::kill(p, SIGKILL);
-  if (!jobExited_) ::waitpid(job_, &jobStatus_, 0);
-  jobExited_ = true;
-  log("job " + std::to_string(job_) + " gone after " + std::to_string(monotonicSeconds() - t0) + " s");
-  job_ = -1;
+  const pid_t pid = launcher_->pid();
+  launcher_->stop();
+  launcher_.reset();
+  log("job " + std::to_string(pid) + " gone after " + std::to_string(monotonicSeconds() - t0) + " s");
 }
 
 int Session::run() {
@@ -350,23 +329,32 @@ int Session::run() {
   double lastFrame = monotonicSeconds();
   double frameStarted = 0;
   std::vector<std::uint8_t> buf(64 << 10);
+  std::vector<pollfd> fds;
   while (!done_ && !gStop) {
-    pollfd fds[4];
-    int n = 0;
-    const int ci = client_ >= 0 ? n : -1;
-    if (client_ >= 0) fds[n++] = {client_, POLLIN, 0};
-    const int mi = master_ >= 0 ? n : -1;
-    if (master_ >= 0) fds[n++] = {master_, POLLIN, 0};
-    const int li = listen_ >= 0 && master_ < 0 ? n : -1;
-    if (li >= 0) fds[n++] = {listen_, POLLIN, 0};
-    const int ei = stderr_ >= 0 ? n : -1;
-    if (ei >= 0) fds[n++] = {stderr_, POLLIN, 0};
-    if (::poll(fds, nfds_t(n), 100) < 0 && errno != EINTR) {
+    // Poll the client, the master, the job's output, the connect-back.
+    fds.clear();
+    const std::size_t ci = fds.size();
+    if (client_ >= 0) fds.push_back({client_, POLLIN, 0});
+    const std::size_t mi = fds.size();
+    if (master_ >= 0) fds.push_back({master_, POLLIN, 0});
+    const std::size_t oi = fds.size();
+    if (launcher_ && launcher_->outputFd() >= 0) fds.push_back({launcher_->outputFd(), POLLIN, 0});
+    const std::size_t bi = fds.size();
+    if (connectBack_) {
+      const auto more = connectBack_->pollFds();
+      fds.insert(fds.end(), more.begin(), more.end());
+    }
+    const auto ready = [&](std::size_t i, std::size_t next) {
+      return i < next && (fds[i].revents & (POLLIN | POLLHUP | POLLERR));
+    };
+    if (::poll(fds.data(), nfds_t(fds.size()), 100) < 0 && errno != EINTR) {
       log(errnoText("poll"));
       break;
     }
     const double now = monotonicSeconds();
-    if (ci >= 0 && (fds[ci].revents & (POLLIN | POLLHUP | POLLERR))) {
+
+    // The client: requests, the end of its stream, a stalled frame, idleness.
+    if (ready(ci, mi)) {
       const ssize_t got = ::read(client_, buf.data(), buf.size());
       if (got <= 0) {
         // A frame left unfinished gets its error, in case the client still reads.
@@ -395,44 +383,41 @@ int Session::run() {
       endConnection(ErrorCode::kTimeout, "the rest of a started frame did not arrive in time", 0);
       break;
     }
+    // A client waiting for its allocation is not idle.
+    if (queued_) lastFrame = now;
     if (now - lastFrame > opt_.idleTimeout) {
       endConnection(ErrorCode::kTimeout, "idle for " + std::to_string(int(opt_.idleTimeout)) + " s", 0);
       break;
     }
-    if (ei >= 0 && (fds[ei].revents & (POLLIN | POLLHUP | POLLERR))) drainStderr();
-    if (li >= 0 && (fds[li].revents & POLLIN)) {
-      std::string error;
-      master_ = tcpAccept(listen_, error);
-      if (master_ < 0) {
-        jobEnded("master connect: " + error);
-        break;
+
+    // The job's output: queue progress, grants, a lost allocation.
+    if (ready(oi, bi) && launcher_) {
+      for (const LaunchEvent& e : launcher_->readOutput()) {
+        onLaunchEvent(e, now);
+        if (done_) break;
       }
-      ::close(std::exchange(listen_, -1));
-      log("master connected after " + std::to_string(now - launchedAt_) + " s");
-      while (!pendingToMaster_.empty() && master_ >= 0) {
-        if (!writeAll(master_, pendingToMaster_.front(), error)) jobEnded("master write failed: " + error);
-        pendingToMaster_.pop_front();
-      }
-      continue;
+      if (done_) break;
     }
-    if (mi >= 0 && (fds[mi].revents & (POLLIN | POLLHUP | POLLERR))) {
+
+    // The connect-back: the master once it shows the secret.
+    if (connectBack_ && fds.size() > bi) {
+      if (auto master = connectBack_->serve(std::span(fds).subspan(bi), now)) {
+        adoptMaster(std::move(*master), now);
+        continue;
+      }
+    }
+
+    // The master's frames, relayed.
+    if (ready(mi, oi)) {
       const ssize_t got = ::read(master_, buf.data(), buf.size());
       if (got <= 0) {
         jobEnded("the master rank's connection closed");
         break;
       }
-      fromMaster_.feed(std::span(buf.data(), std::size_t(got)));
-      while (auto item = fromMaster_.pop()) {
-        onMaster(std::move(*item));
-        if (done_) break;
-      }
-      if (!done_ && fromMaster_.error()) jobEnded("bad frame from the master: " + fromMaster_.error()->text);
+      onMasterBytes(std::span(buf.data(), std::size_t(got)));
     }
-    if (job_ > 0 && !done_ && ::waitpid(job_, &jobStatus_, WNOHANG) == job_) {
-      jobExited_ = true;
-      jobEnded("mpirun exited with status " + std::to_string(WIFEXITED(jobStatus_) ? WEXITSTATUS(jobStatus_) : 128 + WTERMSIG(jobStatus_)));
-    }
-    if (job_ > 0 && master_ < 0 && listen_ >= 0 && now - launchedAt_ > kMasterConnectSeconds)
+    if (launcher_ && !done_ && launcher_->exited()) jobEnded(launcher_->exitText());
+    if (launcher_ && !done_ && master_ < 0 && masterDeadline_ > 0 && now > masterDeadline_)
       jobEnded("the master rank did not connect within " + std::to_string(int(kMasterConnectSeconds)) + " s");
   }
   if (gStop) {
@@ -446,13 +431,6 @@ int Session::run() {
 }
 
 }  // namespace
-
-int rankFromMpirunStderr(const std::string& text) {
-  static const std::regex re(R"(rank\s+(\d+))", std::regex::icase);
-  std::smatch m;
-  if (std::regex_search(text, m, re)) return std::stoi(m[1].str());
-  return -1;
-}
 
 int runSession(const SessionConfig& config, int clientFd) {
   struct sigaction sa {};

@@ -1,10 +1,14 @@
 // The session handler: one forked process per client connection. It does
-// hello and authentication, answers catalog requests, launches the MPI job on
-// SessionOpen, relays frames between the client and the master rank (the
+// hello and authentication, answers catalog requests, launches the job on
+// SessionOpen through the configured launcher (launcher.h), admits the
+// master rank's connect-back only with the session's secret
+// (connect_back.h), relays frames between the client and the master (the
 // master's frames checked and passed on byte for byte, proto::FrameRelay),
-// and tears the job down (its whole process group) when either side goes
-// away.
+// reports a batch queue's progress, and stops the job and releases its
+// resources when either side goes away.
 #pragma once
+
+#include <sys/types.h>
 
 #include <cstdint>
 #include <string>
@@ -18,6 +22,8 @@ struct SessionConfig {
   const DaemonOptions* options = nullptr;
   std::string token;      // empty: no authentication
   std::string nodePath;   // the pvr-node executable
+  std::string advertise;  // the address the master connects back to (advertise.h)
+  pid_t daemonPid = 0;    // names batch jobs: pvr-<daemonPid>-<id>
   std::uint64_t id = 0;   // for log records
   std::vector<int> inherited;  // descriptors of the daemon the handler closes
 };
@@ -25,11 +31,7 @@ struct SessionConfig {
 // Serves `clientFd` until the session ends; returns the exit status for the
 // handler process. Returns when the client leaves, the job dies, a protocol
 // error ends the connection, or SIGTERM/SIGINT arrives (the handler installs
-// them). The job is gone when it returns.
+// them). The job is gone and its allocation released when it returns.
 int runSession(const SessionConfig& config, int clientFd);
-
-// The rank named in an mpirun error message ("... process rank 1 with PID ..."),
-// or -1.
-int rankFromMpirunStderr(const std::string& text);
 
 }  // namespace pvr::daemon

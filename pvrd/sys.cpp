@@ -66,6 +66,47 @@ int tcpAccept(int listenFd, std::string& error) {
   return fd;
 }
 
+std::string routeSourceAddress(const std::string& host, std::string& error) {
+  addrinfo hints{};
+  hints.ai_family = AF_INET;  // the node's link to pvrd speaks IPv4
+  hints.ai_socktype = SOCK_DGRAM;
+  addrinfo* found = nullptr;
+  if (int rc = ::getaddrinfo(host.c_str(), "9", &hints, &found); rc != 0) {
+    error = "getaddrinfo " + host + ": " + ::gai_strerror(rc);
+    return {};
+  }
+  std::string address;
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) {
+    error = errnoText("socket");
+  } else if (::connect(fd, found->ai_addr, found->ai_addrlen) != 0) {
+    error = errnoText("connect") + " (route to " + host + ")";
+  } else {
+    sockaddr_in local{};
+    socklen_t len = sizeof local;
+    char text[INET_ADDRSTRLEN] = {};
+    if (::getsockname(fd, reinterpret_cast<sockaddr*>(&local), &len) == 0 &&
+        ::inet_ntop(AF_INET, &local.sin_addr, text, sizeof text))
+      address = text;
+    else
+      error = errnoText("getsockname");
+  }
+  if (fd >= 0) ::close(fd);
+  ::freeaddrinfo(found);
+  return address;
+}
+
+std::string peerName(int fd) {
+  sockaddr_storage ss{};
+  socklen_t len = sizeof ss;
+  char host[NI_MAXHOST], port[NI_MAXSERV];
+  if (::getpeername(fd, reinterpret_cast<sockaddr*>(&ss), &len) != 0 ||
+      ::getnameinfo(reinterpret_cast<sockaddr*>(&ss), len, host, sizeof host, port, sizeof port,
+                    NI_NUMERICHOST | NI_NUMERICSERV) != 0)
+    return "?";
+  return std::string(host) + ":" + port;
+}
+
 bool writeAll(int fd, std::span<const std::uint8_t> bytes, std::string& error) {
   std::size_t done = 0;
   while (done < bytes.size()) {

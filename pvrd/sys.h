@@ -14,6 +14,15 @@ int tcpListen(const std::string& host, int& port, std::string& error);
 // accept() with CLOEXEC; -1 and error text on failure.
 int tcpAccept(int listenFd, std::string& error);
 
+// The numeric IPv4 address this host sends from towards `host` (a name or
+// address): getsockname of a UDP socket connected to it, which sends no
+// packet. Empty, with error text, when `host` does not resolve to IPv4 or
+// no route leads there.
+std::string routeSourceAddress(const std::string& host, std::string& error);
+
+// "ADDR:PORT" of the peer of a connected socket, "?" if unknown.
+std::string peerName(int fd);
+
 // Writes all bytes; false (with error text) on failure or when the peer stops
 // reading for longer than the socket's send timeout.
 bool writeAll(int fd, std::span<const std::uint8_t> bytes, std::string& error);

@@ -1,4 +1,5 @@
-// The pure parts of pvrd: dataset names, HMAC, options, mpirun messages.
+// The pure parts of pvrd: dataset names, HMAC, options, the advertised
+// address, mpirun messages.
 #include <catch2/catch.hpp>
 
 #include <unistd.h>
@@ -7,10 +8,12 @@
 #include <fstream>
 #include <variant>
 
+#include "advertise.h"
 #include "auth.h"
 #include "catalog.h"
 #include "options.h"
-#include "session.h"
+#include "mpirun_launcher.h"
+#include "sys.h"
 
 namespace fs = std::filesystem;
 using namespace pvr::daemon;
@@ -98,7 +101,60 @@ TEST_CASE("options parse listen address, limits and refuse a public bind without
   CHECK_FALSE(parseOptions({"--data-dir", "/d", "--bogus", "1"}, error));
 }
 
+TEST_CASE("options: --advertise takes numeric IPv4, --launcher a known name, slurm's options need slurm") {
+  std::string error;
+  auto o = parseOptions({"--data-dir", "/d", "--advertise", "10.213.7.10", "--launcher", "slurm", "--partition", "vis",
+                         "--time", "30", "--salloc", "/x/salloc", "--scancel", "/x/scancel"},
+                        error);
+  REQUIRE(o);
+  CHECK(o->advertise == "10.213.7.10");
+  CHECK(o->launcher == "slurm");
+  CHECK(o->partition == "vis");
+  CHECK(o->time == "30");
+  CHECK(o->salloc == "/x/salloc");
+  CHECK(o->scancel == "/x/scancel");
+  CHECK(parseOptions({"--data-dir", "/d"}, error)->launcher == "mpirun");
+  CHECK_FALSE(parseOptions({"--data-dir", "/d", "--advertise", "h0"}, error));
+  CHECK(error == "--advertise takes a numeric IPv4 address, not 'h0'");
+  CHECK_FALSE(parseOptions({"--data-dir", "/d", "--launcher", "pbs"}, error));
+  CHECK(error == "--launcher takes one of mpirun, slurm, not 'pbs'");
+  CHECK_FALSE(parseOptions({"--data-dir", "/d", "--partition", "vis"}, error));
+  CHECK(error == "--partition and --time need --launcher slurm");
+  CHECK_FALSE(parseOptions({"--data-dir", "/d", "--launcher", "slurm", "--hostfile", "/h"}, error));
+  CHECK_THAT(error, Catch::StartsWith("--hostfile does not go with --launcher slurm"));
+}
+
+TEST_CASE("the first host of a hostfile: first word of the first line with one, no user, no comment") {
+  CHECK(firstHostfileHost("# cluster\n\n  h1 slots=2 max_slots=4\nh2 slots=2\n") == "h1");
+  CHECK(firstHostfileHost("pvr@10.213.7.11 slots=1") == "10.213.7.11");
+  CHECK(firstHostfileHost("h3# a comment right after") == "h3");
+  CHECK(firstHostfileHost("# nothing\n   \n") == "");
+}
+
+TEST_CASE("the advertised address: the option, else the route towards the first hostfile host, else loopback") {
+  std::string error;
+  DaemonOptions o;
+  CHECK(advertiseAddress(o, error) == "127.0.0.1");
+  o.advertise = "10.213.7.10";
+  CHECK(advertiseAddress(o, error) == "10.213.7.10");
+  o.advertise.clear();
+  const fs::path hostfile = fs::path(PVR_TEST_TMP) / ("hostfile_" + std::to_string(::getpid()));
+  fs::create_directories(hostfile.parent_path());
+  std::ofstream(hostfile) << "# loopback hosts\nlocalhost slots=2\n";
+  o.hostfile = hostfile.string();
+  // The route to a loopback host leaves from loopback.
+  CHECK(advertiseAddress(o, error) == "127.0.0.1");
+  CHECK(routeSourceAddress("127.0.0.2", error) == "127.0.0.1");
+  o.hostfile = (hostfile.string() + ".missing");
+  CHECK(advertiseAddress(o, error).empty());
+  CHECK_THAT(error, Catch::StartsWith("cannot read hostfile "));
+  std::ofstream(hostfile) << "no-such-host.invalid\n";
+  o.hostfile = hostfile.string();
+  CHECK(advertiseAddress(o, error).empty());
+  CHECK_THAT(error, Catch::Contains("no-such-host.invalid") && Catch::Contains("--advertise"));
+}
+
 TEST_CASE("the failed rank is read from mpirun's message") {
-  CHECK(rankFromMpirunStderr("mpirun noticed that process rank 1 with PID 4242 on node x exited on signal 9 (Killed).") == 1);
-  CHECK(rankFromMpirunStderr("something else") == -1);
+  CHECK(rankFromMpirunOutput("mpirun noticed that process rank 1 with PID 4242 on node x exited on signal 9 (Killed).") == 1);
+  CHECK(rankFromMpirunOutput("something else") == -1);
 }

@@ -1,14 +1,18 @@
 // The fake MPI job of fake_master.h. pvrd calls it as
-//   fake_master --oversubscribe ... -np N NODE --server --connect HOST:PORT --data-dir DIR
-// It serves one connection and exits when it closes.
+//   fake_master --oversubscribe ... -np N -x PVR_JOB_SECRET NODE --server --connect HOST:PORT --data-dir DIR
+// It makes the connect-back trials it is asked for, then serves one
+// connection and exits when it closes.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 #include <string>
+#include <thread>
 
 #include "fake_master.h"
 
@@ -58,6 +62,50 @@ void render(const std::string& script, std::uint32_t id) {
   }
 }
 
+int connectTo(const std::string& host, int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(std::uint16_t(port));
+  ::inet_pton(AF_INET, host.c_str(), &a.sin_addr);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+    std::perror("fake_master: connect");
+    std::exit(1);
+  }
+  return fd;
+}
+
+// Waits until the handler closes `fd`; exits with status 3 if it does not.
+void expectClosed(int fd, const std::string& trial) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  std::uint8_t buf[256];
+  while (std::chrono::steady_clock::now() < until) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n <= 0) {
+      ::close(fd);
+      return;
+    }
+  }
+  std::fprintf(stderr, "fake_master: pvrd kept the '%s' connect-back open\n", trial.c_str());
+  std::exit(3);
+}
+
+// The connect-backs pvrd must refuse, as kTrialsVariable lists them.
+void tryRefusedConnectBacks(const std::string& host, int port) {
+  const char* list = std::getenv(kTrialsVariable);
+  std::istringstream trials(list ? list : "");
+  for (std::string trial; std::getline(trials, trial, ',');) {
+    // A silent connection is never closed here: it stays open while the
+    // master connects.
+    gSocket = connectTo(host, port);
+    if (trial == kTrialSilent) continue;
+    if (trial == kTrialWrongSecret) send(proto::JobHello{std::string(kWrongSecret)}, 0);
+    else if (trial == kTrialNoSecret) send(proto::JobHello{""}, 0);
+    else send(proto::SessionReady{2, {}}, 0);
+    expectClosed(gSocket, trial);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -69,15 +117,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fake_master: no --connect HOST:PORT\n");
     return 2;
   }
-  gSocket = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(std::uint16_t(std::atoi(connect.c_str() + colon + 1)));
-  ::inet_pton(AF_INET, connect.substr(0, colon).c_str(), &a.sin_addr);
-  if (::connect(gSocket, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-    std::perror("fake_master: connect");
-    return 1;
-  }
+  const std::string host = connect.substr(0, colon);
+  const int port = std::atoi(connect.c_str() + colon + 1);
+  tryRefusedConnectBacks(host, port);
+  gSocket = connectTo(host, port);
+  const char* secret = std::getenv("PVR_JOB_SECRET");
+  send(proto::JobHello{secret ? secret : ""}, 0);
   proto::FrameDecoder decoder;
   std::string script(kScriptGood);
   std::vector<std::uint8_t> buf(65536);

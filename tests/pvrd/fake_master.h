@@ -1,8 +1,15 @@
 // A stand-in for the MPI job in the daemon process tests: pvrd runs it as
 // its --mpirun, it connects back to the session handler like the master
-// rank and answers requests with frames the test chooses, including frames
-// pvrd must refuse. The scene JSON of a SetScene names what the next
-// RenderFrame gets (kScript*).
+// rank (JobHello with PVR_JOB_SECRET first) and answers requests with
+// frames the test chooses, including frames pvrd must refuse. The scene
+// JSON of a SetScene names what the next RenderFrame gets (kScript*).
+//
+// Before that it can try connect-backs pvrd must refuse, listed in the
+// environment variable kTrialsVariable (pvrd passes its environment on),
+// comma-separated, in order: kTrialWrongSecret, kTrialNoSecret,
+// kTrialOtherFrame each wait until the handler closes them (the fake
+// master gives up with exit status 3 after 30 s); a kTrialSilent
+// connection stays open, saying nothing, while the others go on.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +28,18 @@ inline constexpr std::string_view kScriptOversize = "oversize";
 inline constexpr std::string_view kScriptInconsistent = "inconsistent";
 // Bytes that are no frame: the stream cannot go on.
 inline constexpr std::string_view kScriptGarbage = "garbage";
+
+inline constexpr const char* kTrialsVariable = "PVR_FAKE_MASTER_TRIALS";
+// JobHello with a secret that is not the session's.
+inline constexpr std::string_view kTrialWrongSecret = "wrong";
+// JobHello with an empty secret.
+inline constexpr std::string_view kTrialNoSecret = "none";
+// A first frame other than JobHello.
+inline constexpr std::string_view kTrialOtherFrame = "other";
+// Connected, nothing sent.
+inline constexpr std::string_view kTrialSilent = "silent";
+// The wrong secret kTrialWrongSecret sends, with bytes the log must mask.
+inline constexpr std::string_view kWrongSecret = "\x01wrong\x7f";
 
 // The good frame: a 64 x 48 RGBA gradient, zlib-compressed by the codec.
 inline proto::ImageFrame fakeGoodFrame() {

@@ -1,0 +1,52 @@
+#include "mpirun_launcher.h"
+
+#include <regex>
+
+namespace pvr::daemon {
+namespace {
+
+constexpr std::size_t kTailInText = 600;
+
+class MpirunLauncher final : public Launcher {
+ public:
+  explicit MpirunLauncher(const DaemonOptions& options) : Launcher(options) {}
+  std::string_view program() const override { return "mpirun"; }
+  std::string endText(const std::string& why) const override { return mpirunEndText(why, process_.tail()); }
+
+ private:
+  std::vector<std::string> command(const JobSpec& spec) const override {
+    return mpirunCommand(spec, options_, true);
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Launcher> makeMpirunLauncher(const DaemonOptions& options) {
+  return std::make_unique<MpirunLauncher>(options);
+}
+
+std::vector<std::string> mpirunCommand(const JobSpec& spec, const DaemonOptions& options, bool withHostfile) {
+  std::vector<std::string> args{options.mpirun, "--oversubscribe", "--bind-to", "none", "-np", std::to_string(spec.ranks)};
+  if (withHostfile && !options.hostfile.empty()) args.insert(args.end(), {"--hostfile", options.hostfile});
+  // -x hands the variable to every rank, rank 0 included, wherever it runs.
+  args.insert(args.end(), {"-x", "PVR_JOB_SECRET", spec.nodePath, "--server", "--connect", spec.connect, "--data-dir",
+                           spec.dataDir});
+  return args;
+}
+
+int rankFromMpirunOutput(const std::string& text) {
+  static const std::regex re(R"(rank\s+(\d+))", std::regex::icase);
+  std::smatch m;
+  if (std::regex_search(text, m, re)) return std::stoi(m[1].str());
+  return -1;
+}
+
+std::string mpirunEndText(const std::string& why, const std::string& outputTail) {
+  const int rank = rankFromMpirunOutput(outputTail);
+  if (rank >= 0) return "rank " + std::to_string(rank) + " failed: the rendering job ended (" + why + ")";
+  const std::string tail =
+      outputTail.size() > kTailInText ? outputTail.substr(outputTail.size() - kTailInText) : outputTail;
+  return "the rendering job ended unexpectedly (" + why + "): " + tail;
+}
+
+}  // namespace pvr::daemon
