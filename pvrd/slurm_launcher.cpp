@@ -9,8 +9,9 @@
 namespace pvr::daemon {
 namespace {
 
-// How long scancel may take to reach the controller.
-constexpr double kScancelSeconds = 5;
+// How long scancel may take to reach the controller: a stopping pvrd
+// gives each handler 5 s in all (pvrd_main.cpp).
+constexpr double kScancelSeconds = 3;
 
 class SlurmLauncher final : public Launcher {
  public:
