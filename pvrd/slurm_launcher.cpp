@@ -19,7 +19,12 @@ class SlurmLauncher final : public Launcher {
   std::string_view program() const override { return "salloc"; }
 
   std::string endText(const std::string& why) const override {
-    if (auto failed = monitor_.failureText(why)) return *failed;
+    // When salloc said nothing about the allocation (it could not even
+    // start), its last line of output is the best reason there is.
+    std::string lastLine = process_.tail();
+    while (!lastLine.empty() && lastLine.back() == '\n') lastLine.pop_back();
+    lastLine.erase(0, lastLine.rfind('\n') + 1);
+    if (auto failed = monitor_.failureText(lastLine.empty() ? why : why + ": " + lastLine)) return *failed;
     return mpirunEndText(why, process_.tail());
   }
 

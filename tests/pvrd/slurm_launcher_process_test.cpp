@@ -149,3 +149,23 @@ TEST_CASE("slurm: the allocation is released when the client vanishes in the que
   CHECK(secondsUntilJobGone(f.dataDir, 3) >= 0);
   CHECK(fileComesToHold(f.scancelLog, "91\n", 10));
 }
+
+TEST_CASE("slurm: a salloc that cannot run answers SessionOpen with RANK_FAILED saying why") {
+  SlurmFiles f("slurmmissing");
+  std::vector<std::string> options = slurmOptions();
+  options[3] = (f.dataDir / "no-salloc-here").string();
+  Daemon d(f.dataDir, options, {{"FAKE_SCANCEL_LOG", f.scancelLog}}, f.log);
+  Client c(d.port);
+  c.hello();
+  const auto open = c.send(proto::SessionOpen{2, {}, ""});
+  const auto e = c.next(30);
+  REQUIRE(e);
+  CHECK(e->info == proto::FrameInfo{open, proto::kFlagFinal});
+  REQUIRE(std::holds_alternative<proto::ErrorMessage>(e->message));
+  const auto& error = std::get<proto::ErrorMessage>(e->message);
+  CHECK(error.code == proto::ErrorCode::kRankFailed);
+  CHECK(error.text == "slurm: allocation failed: salloc exited with status 127: exec: No such file or directory " +
+                          options[3]);
+  // No job id was ever given: there is nothing to cancel.
+  CHECK_FALSE(fs::exists(f.scancelLog));
+}
