@@ -8,7 +8,6 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstdlib>
 #include <cstring>
 
 #include "error.h"
@@ -33,11 +32,6 @@ PvrdLink::PvrdLink(const std::string& host, int port) {
   const int one = 1;
   ::setsockopt(fd_, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
   open_ = true;
-  // The handler admits the connection only with the session's secret, the
-  // first frame (docs/pvrd.md); it leaves the environment with it.
-  const char* secret = std::getenv("PVR_JOB_SECRET");
-  send(proto::JobHello{secret ? secret : ""}, 0);
-  ::unsetenv("PVR_JOB_SECRET");
 }
 
 PvrdLink::~PvrdLink() { close(); }
