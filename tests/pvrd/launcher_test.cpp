@@ -36,7 +36,7 @@ TEST_CASE("mpirun command: ranks, hostfile, the secret exported by name, the con
              "/opt/pvr/pvr-node", "--server", "--connect", "10.213.7.10:40001", "--data-dir", "/data"});
 }
 
-TEST_CASE("salloc command: one word per option, then mpirun inside the allocation; the secret never in argv") {
+TEST_CASE("salloc command: one word per option, then mpirun inside the allocation, and the secret never in argv") {
   DaemonOptions o = options("slurm");
   CHECK(sallocCommand(spec(), o) ==
         Args{"salloc", "--ntasks=3", "--job-name=pvr-100-7", "--kill-command=TERM", "mpirun", "--oversubscribe",
