@@ -77,10 +77,10 @@ int runServer(const ServerOptions& options) {
   // compositing model's calibration; SessionOpen's layout follows.
   int status = 0;
   if (auto f = invoke(state, actions::SetLayout{})) {
-    std::fprintf(stderr, "pvr-node: %s\n", f->describe().c_str());
+    std::fprintf(stderr, "pvr-node: %s\n", describeOnHost(*f, state.hosts).c_str());
     status = 1;
   } else if (auto g = invoke(state, actions::Calibrate{})) {
-    std::fprintf(stderr, "pvr-node: %s\n", g->describe().c_str());
+    std::fprintf(stderr, "pvr-node: %s\n", describeOnHost(*g, state.hosts).c_str());
     status = 1;
   } else {
     Master(state, *link).serve();
