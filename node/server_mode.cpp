@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
-
 #include <string>
 
 #include "dispatch.h"
