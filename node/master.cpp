@@ -58,7 +58,7 @@ void Master::on(const proto::SessionOpen& m, std::uint32_t id) { layout(m.cluste
 void Master::on(const proto::SetLayout& m, std::uint32_t id) { layout(m.clusters, id); }
 
 void Master::layout(const std::vector<proto::ClusterSpec>& clusters, std::uint32_t id) {
-  if (auto f = invoke(state_, actions::SetLayout{clusters})) return sendError(wireError(*f), id);
+  if (auto f = invoke(state_, actions::SetLayout{clusters})) return sendError(wireError(*f, state_.hosts), id);
   send(proto::SessionReady{std::uint32_t(state_.world.size()), state_.layout.specs()}, id);
 }
 
@@ -69,7 +69,7 @@ void Master::on(const proto::SetScene& request, std::uint32_t id) {
   // Without a volume there is nothing for the ranks to load yet: the
   // checked scene waits for the dataset.
   if (next.hasVolume()) {
-    if (auto f = invoke(state_, actions::SetScene{next.doc.dump(), next.settings})) return sendError(wireError(*f), id);
+    if (auto f = invoke(state_, actions::SetScene{next.doc.dump(), next.settings})) return sendError(wireError(*f, state_.hosts), id);
   }
   scene_ = std::move(next);
   send(proto::Ok{}, id);
@@ -95,7 +95,7 @@ void Master::on(const proto::PerformanceRequest& p, std::uint32_t id) {
   const std::int32_t cluster = p.cluster == proto::kAllClusters ? -1 : std::int32_t(p.cluster);
   const auto failure = p.query == proto::PerformanceQuery::kMemory ? invoke(state_, actions::ReportMemory{cluster})
                                                                     : invoke(state_, actions::CompLatency{cluster});
-  if (failure) return sendError(wireError(*failure), id);
+  if (failure) return sendError(wireError(*failure, state_.hosts), id);
   send(proto::PerformanceReply{p.query, state_.reply.dump()}, id);
 }
 
@@ -127,7 +127,7 @@ void Master::renderSequence(int count, const std::function<core::CameraSpec(int)
     for (int k = first; k < std::min(count, first + groups); ++k)
       wave.frames.push_back({std::uint32_t(k), cameraArgs(cameraOf(k))});
     if (auto f = invoke(state_, wave)) {
-      sendError(wireError(*f), id);
+      sendError(wireError(*f, state_.hosts), id);
       break;
     }
     // Between waves: answer what must not wait; keep the rest for later.

@@ -62,6 +62,9 @@ struct NodeState {
   comm::Communicator& world;
   comm::CommandChannel& commands;  // the master's commands to the slaves
   std::string dataDir;  // real path; datasets resolve inside it
+  // Every world rank's host name, in rank order, gathered once at start
+  // (hosts.h): status `hosts`, and the host in a rank's failure text.
+  std::vector<std::string> hosts;
   bool running = true;
 
   // Layout.

@@ -13,12 +13,15 @@
 // (the usage text lists the registered strategies and decompositions).
 // Every rank reads its own brick (or rank 0 scatters when the format cannot
 // read part of a file), renders it, and the ranks composite; rank 0 writes
-// the image and prints the time breakdown. Any rank's failure makes every
-// rank exit 1 with the first failure printed once, by rank 0.
+// the image and prints the hosts of the ranks and the time breakdown. Any
+// rank's failure makes every rank exit 1 with the first failure printed
+// once, by rank 0, naming the rank and its host.
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "frame.h"
+#include "hosts.h"
 #include "image_io.h"
 #include "mpi_communicator.h"
 #include "report.h"
@@ -124,7 +127,7 @@ Args parseArgs(int argc, char** argv) {
   return a;
 }
 
-int run(const Args& args, comm::Communicator& comm) {
+int run(const Args& args, const std::vector<std::string>& hosts, comm::Communicator& comm) {
   core::Scene scene;
   comm::runAgreed(comm, [&] {
     scene = core::loadSceneFile(args.scene);
@@ -135,7 +138,7 @@ int run(const Args& args, comm::Communicator& comm) {
     if (comm.rank() != 0) return;
     core::writeImage(result.image, result.scene.image.background, args.output);
     if (!args.stats.empty()) node::writeStatsCsv(args.stats, result, args.frame);
-    std::printf("%s: %s", args.output.c_str(), node::formatReport(result, args.frame).c_str());
+    std::printf("%s: %s", args.output.c_str(), node::formatReport(result, args.frame, hosts).c_str());
   });
   return 0;
 }
@@ -155,11 +158,15 @@ int main(int argc, char** argv) {
   }
   comm::MpiEnvironment mpi(&argc, &argv);
   comm::Communicator& comm = mpi.world();
+  const std::vector<std::string> hosts = node::gatherHostNames(comm);
   try {
-    return run(parseArgs(argc, argv), comm);
+    return run(parseArgs(argc, argv), hosts, comm);
   } catch (const Error& e) {
     if (comm.rank() == 0) {
-      std::fprintf(stderr, "pvr-node: %s\n", e.what());
+      // A rank's failure names its host: "rank 2 on h1: ...".
+      const auto* failure = dynamic_cast<const comm::FailureError*>(&e);
+      std::fprintf(stderr, "pvr-node: %s\n",
+                   failure ? node::describeOnHost(failure->failure(), hosts).c_str() : e.what());
       if (e.code() == ErrorCode::kInvalidArgument) std::fputs(usage().c_str(), stderr);
     }
     return e.code() == ErrorCode::kInvalidArgument ? 2 : 1;

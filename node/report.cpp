@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "error.h"
+#include "hosts.h"
 
 namespace pvr::node {
 
@@ -45,13 +46,15 @@ TrafficTotals sumTraffic(const std::vector<RankReport>& ranks) {
   return t;
 }
 
-std::string formatReport(const FrameResult& result, const FrameOptions& options) {
+std::string formatReport(const FrameResult& result, const FrameOptions& options,
+                         const std::vector<std::string>& hosts) {
   const auto& ranks = result.ranks;
   const int n = int(ranks.size());
   std::string out;
   out += line("%s, %d ranks, %s, %s decomposition, %dx%d\n", result.volume.c_str(), n,
               options.strategy.c_str(), std::string(decompositionName(options.decomposition)).c_str(),
               result.scene.image.width, result.scene.image.height);
+  out += "hosts: " + hostRuns(hosts) + "\n";
   out += "time (s)    max       mean      min\n";
   for (const Column& c : timeColumns()) {
     double mx = 0, sum = 0, mn = 1e300;

@@ -1,4 +1,5 @@
-// The time breakdown of a distributed frame, printed like Table 1 of the
+// The time breakdown of a distributed frame, after a header naming the
+// volume, the ranks and their hosts, printed like Table 1 of the
 // binary-swap paper (dist, rend, comp, comm, send: max over ranks), with
 // the bytes and messages of compositing and the voxel bytes per rank; and
 // the same per rank as CSV.
@@ -19,7 +20,9 @@ struct TrafficTotals {
 };
 TrafficTotals sumTraffic(const std::vector<RankReport>& ranks);
 
-std::string formatReport(const FrameResult& result, const FrameOptions& options);
+// `hosts`: every rank's host name, in rank order (hosts.h).
+std::string formatReport(const FrameResult& result, const FrameOptions& options,
+                         const std::vector<std::string>& hosts);
 // One row per rank; throws pvr::Error naming the path if it cannot write.
 void writeStatsCsv(const std::string& path, const FrameResult& result, const FrameOptions& options);
 

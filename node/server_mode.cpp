@@ -4,15 +4,36 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <string>
 
 #include "dispatch.h"
+#include "hosts.h"
 #include "master.h"
 #include "mpi_communicator.h"
 #include "pvrd_link.h"
 
 namespace pvr::node {
 
+namespace {
+
+// The one-time secret pvrd hands the job it launches (mpirun -x), which the
+// master proves itself with on the connect-back (docs/runtime.md).
+constexpr const char* kJobSecretVariable = "PVR_JOB_SECRET";
+
+// The secret, taken out of this process's environment so that nothing this
+// rank starts inherits it. Called before MPI starts its threads: unsetenv
+// must not race with a getenv.
+std::string takeJobSecret() {
+  const char* value = std::getenv(kJobSecretVariable);
+  std::string secret = value ? value : "";
+  ::unsetenv(kJobSecretVariable);
+  return secret;
+}
+
+}  // namespace
+
 int runServer(const ServerOptions& options) {
+  const std::string secret = takeJobSecret();
   comm::MpiEnvironment mpi(nullptr, nullptr);
   comm::Communicator& world = mpi.world();
   char real[PATH_MAX];
@@ -24,6 +45,12 @@ int runServer(const ServerOptions& options) {
   if (world.rank() == 0) {
     try {
       link = std::make_unique<PvrdLink>(options.host, options.port);
+      // The first frame, before anything else: pvrd relays nothing until it
+      // has checked the secret, and refuses an empty one.
+      if (secret.empty())
+        std::fprintf(stderr, "pvr-node: rank 0: %s is not set (pvrd sets it for the job it launches); "
+                     "the connect-back will be refused\n", kJobSecretVariable);
+      link->send(proto::JobHello{secret}, 0);
     } catch (const Error& e) {
       std::fprintf(stderr, "pvr-node: rank 0: %s\n", e.what());
       std::fflush(stderr);
@@ -40,6 +67,7 @@ int runServer(const ServerOptions& options) {
     }
     return 1;
   }
+  state.hosts = gatherHostNames(world);
   if (world.rank() != 0) {
     serveSlave(state);
     return 0;
@@ -48,10 +76,10 @@ int runServer(const ServerOptions& options) {
   // compositing model's calibration; SessionOpen's layout follows.
   int status = 0;
   if (auto f = invoke(state, actions::SetLayout{})) {
-    std::fprintf(stderr, "pvr-node: %s\n", f->describe().c_str());
+    std::fprintf(stderr, "pvr-node: %s\n", describeOnHost(*f, state.hosts).c_str());
     status = 1;
   } else if (auto g = invoke(state, actions::Calibrate{})) {
-    std::fprintf(stderr, "pvr-node: %s\n", g->describe().c_str());
+    std::fprintf(stderr, "pvr-node: %s\n", describeOnHost(*g, state.hosts).c_str());
     status = 1;
   } else {
     Master(state, *link).serve();

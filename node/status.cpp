@@ -7,6 +7,7 @@
 #include <string>
 #include <string_view>
 
+#include "hosts.h"
 #include "strategy.h"
 
 namespace pvr::node {
@@ -75,6 +76,7 @@ std::vector<proto::KeyValue> statusEntries(const NodeState& state, const Session
   std::vector<proto::KeyValue> out{
       {"state", session.rendering ? "rendering" : "session open"},
       {"ranks", std::to_string(state.world.size())},
+      {"hosts", hostList(state.hosts)},
       {"master_pid", std::to_string(::getpid())},
       {"clusters", std::to_string(state.layout.clusters.size())},
       {"groups", std::to_string(state.layout.groups)},

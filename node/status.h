@@ -1,5 +1,5 @@
 // The master's answer to StatusRequest ("list status"): connection state,
-// the layout, the settings and the lists a client offers (strategies from
+// the hosts of the ranks, the layout, the settings and the lists a client offers (strategies from
 // the composite registry, decompositions from distribute.h), and once a
 // dataset is loaded the camera in use, image size, bounds, value range and
 // resolved transfer function. Keys and formats: docs/runtime.md.

@@ -1,5 +1,7 @@
 #include "wire_error.h"
 
+#include "hosts.h"
+
 namespace pvr::node {
 
 namespace {
@@ -21,6 +23,8 @@ proto::ErrorCode wireCode(pvr::ErrorCode code) {
 
 proto::ProtocolError wireError(const pvr::Error& error) { return {wireCode(error.code()), error.what()}; }
 
-proto::ProtocolError wireError(const comm::Failure& failure) { return {wireCode(failure.code), failure.describe()}; }
+proto::ProtocolError wireError(const comm::Failure& failure, const std::vector<std::string>& hosts) {
+  return {wireCode(failure.code), describeOnHost(failure, hosts)};
+}
 
 }  // namespace pvr::node

@@ -52,14 +52,28 @@ std::uint32_t Session::send(const proto::Message& message, bool synchronous) {
   return id;
 }
 
-std::vector<proto::Message> Session::query(const proto::Message& request, double timeoutSeconds) {
+std::vector<proto::Message> Session::query(const proto::Message& request, double timeoutSeconds,
+                                           const std::function<void(const proto::Message&)>& onProgress) {
   const std::uint32_t id = send(request, true);
-  const bool answered = runEventsUntil(
-      [&] {
-        const auto it = pending_.find(id);
-        return it == pending_.end() || it->second.done;
-      },
-      timeoutSeconds);
+  std::size_t seen = 0;  // answers handed to onProgress
+  bool answered = false;
+  for (;;) {
+    // Until the FINAL answer, or (with onProgress) until one more answer.
+    answered = runEventsUntil(
+        [&] {
+          const auto it = pending_.find(id);
+          return it == pending_.end() || it->second.done || (onProgress && it->second.replies.size() > seen);
+        },
+        timeoutSeconds);
+    const auto it = pending_.find(id);
+    if (it == pending_.end()) break;
+    // Progress: every answer but a FINAL one (an Error is kept apart), also
+    // those that arrived together with it.
+    const Pending& p = it->second;
+    const std::size_t progress = p.replies.size() - (p.done && !p.error && !p.replies.empty() ? 1 : 0);
+    while (onProgress && seen < progress) onProgress(p.replies[seen++]);
+    if (!answered || p.done) break;
+  }
   const auto it = pending_.find(id);
   if (it == pending_.end()) throw TclError({"PVR", "CONNECT", "LOST"}, "session " + name_ + ": the connection is gone");
   Pending p = std::move(it->second);

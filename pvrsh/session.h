@@ -60,6 +60,16 @@ struct Sequence {
   bool cancelled = false;    // frames still arriving are dropped
 };
 
+// What `open` was asked for.
+struct OpenRequest {
+  std::string host;
+  int port = 0;
+  std::uint32_t ranks = 0;  // 0: the server's default
+  std::string account;      // batch-system account; empty: the site's default
+  std::string tokenFile;    // empty: no token
+  double timeout = 30;      // seconds for each step (at least 120 for the job to start)
+};
+
 // A request whose answer someone waits for (open, queries) or that only
 // reports failure (SetScene, SetLayout, Cancel).
 struct Pending {
@@ -82,13 +92,18 @@ class Session : public Connection::Listener {
   static void freeProc(char* data);
 
   // ---- Operations behind the subcommands; each throws TclError ----
-  void open(const std::string& host, int port, std::uint32_t ranks, const std::string& tokenFile, double timeout);
+  void open(const OpenRequest& request);
   void close(const std::string& reason);
   void applySettings(const SettingsChange& change);
   std::uint32_t render(const proto::Message& request, std::uint32_t total, const std::string& label);
   int cancel();
   std::size_t wait(double timeoutSeconds);
-  std::vector<proto::Message> query(const proto::Message& request, double timeoutSeconds);
+  // Sends `request` and runs the event loop until its FINAL answer, which
+  // it returns with the answers before it. With `onProgress`, each answer
+  // before the FINAL one is handed to it as it arrives and starts the
+  // timeout afresh (a SessionOpen waiting in a batch queue).
+  std::vector<proto::Message> query(const proto::Message& request, double timeoutSeconds,
+                                    const std::function<void(const proto::Message&)>& onProgress = {});
   Tcl_Obj* statusObj();
   Tcl_Obj* timingObj() const;
   // Throws {PVR STATE NOTOPEN} naming `what` unless the session is open.

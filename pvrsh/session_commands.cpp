@@ -37,32 +37,40 @@ void splitHostPort(const std::string& address, std::string& host, int& port) {
   if (host.empty()) argsError("HOST", "open: no host in '" + address + "'");
 }
 
-// :s open HOST[:PORT] ?-ranks N? ?-token-file F? ?-timeout S?
+// A batch-system account: one word of printable characters. What accounts
+// exist is the batch system's to judge (pvrd passes it to Slurm).
+std::string accountName(const std::string& v) {
+  if (v.empty()) argsError("ACCOUNT", "-account needs an account name (leave the option out for the site's default)");
+  for (unsigned char c : v)
+    if (!std::isgraph(c) && c < 0x80)
+      argsError("ACCOUNT", "-account '" + v + "' is not one word: an account name has no spaces or control characters");
+  return v;
+}
+
+// :s open HOST[:PORT] ?-ranks N? ?-account A? ?-token-file F? ?-timeout S?
 int openCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   if (objc < 3 || objc % 2 == 0) {
-    Tcl_WrongNumArgs(interp, 2, objv, "host?:port? ?-ranks n? ?-token-file file? ?-timeout seconds?");
+    Tcl_WrongNumArgs(interp, 2, objv, "host?:port? ?-ranks n? ?-account name? ?-token-file file? ?-timeout seconds?");
     return TCL_ERROR;
   }
-  static const char* const kOptions[] = {"-ranks", "-timeout", "-token-file", nullptr};
-  std::uint32_t ranks = s.ranksWanted_;
-  std::string tokenFile;
-  if (const char* env = std::getenv("PVR_TOKEN_FILE")) tokenFile = env;
-  double timeout = 30;
+  static const char* const kOptions[] = {"-account", "-ranks", "-timeout", "-token-file", nullptr};
+  OpenRequest request;
+  request.ranks = s.ranksWanted_;
+  if (const char* env = std::getenv("PVR_TOKEN_FILE")) request.tokenFile = env;
   for (int i = 3; i < objc; i += 2) {
     int index = 0;
     if (Tcl_GetIndexFromObj(interp, objv[i], kOptions, "option", 0, &index) != TCL_OK)
       throw TclError({"PVR", "ARGS", "OPTION"}, Tcl_GetStringResult(interp));
     const std::string v = str(objv[i + 1]);
-    if (index == 0) ranks = std::uint32_t(parseInteger("-ranks", v, 1, 1 << 20));
-    if (index == 1) timeout = parseNumbers("-timeout", v, 1)[0];
-    if (index == 2) tokenFile = v;
+    if (index == 0) request.account = accountName(v);
+    if (index == 1) request.ranks = std::uint32_t(parseInteger("-ranks", v, 1, 1 << 20));
+    if (index == 2) request.timeout = parseNumbers("-timeout", v, 1)[0];
+    if (index == 3) request.tokenFile = v;
   }
-  if (!(timeout > 0)) argsError("TIMEOUT", "-timeout must be > 0 seconds");
-  std::string host;
-  int port = 0;
-  splitHostPort(str(objv[2]), host, port);
-  s.ranksWanted_ = ranks;
-  s.open(host, port, ranks, tokenFile, timeout);
+  if (!(request.timeout > 0)) argsError("TIMEOUT", "-timeout must be > 0 seconds");
+  splitHostPort(str(objv[2]), request.host, request.port);
+  s.ranksWanted_ = request.ranks;
+  s.open(request);
   return TCL_OK;
 }
 

@@ -1,6 +1,8 @@
 // Session::open: connect, Hello and Welcome, the token challenge when the
 // server asks (HMAC-SHA256 of its nonce keyed with the shared token), and
-// SessionOpen, which starts the MPI job (docs/protocol.md, "The conversation").
+// SessionOpen, which starts the MPI job (docs/protocol.md, "The
+// conversation"), printing the server's progress while a batch system
+// keeps the job queued.
 #include <openssl/evp.h>
 #include <openssl/hmac.h>
 
@@ -26,12 +28,37 @@ std::string readToken(const std::string& path) {
   return token;
 }
 
+// A SessionOpen's progress while the job waits for its ranks: one line on
+// stderr, "pvr: queued: slurm job 12: Priority", from the StatusReply's
+// keys state, batch_job and reason (docs/pvrsh.md).
+void printQueueProgress(const proto::Message& m) {
+  const auto* reply = std::get_if<proto::StatusReply>(&m);
+  if (!reply) return;
+  std::string state = "waiting", job, reason;
+  for (const auto& kv : reply->entries) {
+    if (kv.key == "state") state = kv.value;
+    if (kv.key == "batch_job") job = kv.value;
+    if (kv.key == "reason") reason = kv.value;
+  }
+  std::string line = "pvr: " + state;
+  if (!job.empty()) line += ": slurm job " + job;
+  if (!reason.empty()) line += ": " + reason;
+  line += "\n";
+  // Through Tcl's stderr channel, so a script (or a test) that redirects
+  // the channel sees the line.
+  if (Tcl_Channel err = Tcl_GetStdChannel(TCL_STDERR)) {
+    Tcl_WriteChars(err, line.data(), int(line.size()));
+    Tcl_Flush(err);
+  }
+}
+
 }  // namespace
 
-void Session::open(const std::string& host, int port, std::uint32_t ranks, const std::string& tokenFile, double timeout) {
+void Session::open(const OpenRequest& request) {
+  const double timeout = request.timeout;
   if (state_ == State::kOpen || state_ == State::kConnecting)
     throw TclError({"PVR", "STATE", "OPEN"}, "session " + name_ + " is already open to " + peer_ + " (close it first)");
-  const std::string token = tokenFile.empty() ? std::string() : readToken(tokenFile);
+  const std::string token = request.tokenFile.empty() ? std::string() : readToken(request.tokenFile);
   Tcl_Preserve(this);
   try {
     // Step 1: TCP connect on the event loop.
@@ -41,8 +68,8 @@ void Session::open(const std::string& host, int port, std::uint32_t ranks, const
     closeReason_.clear();
     lastFailure_.reset();
     state_ = State::kConnecting;
-    peer_ = host + ":" + std::to_string(port);
-    conn_ = std::make_unique<Connection>(*this, host, port, std::min(timeout, 30.0));
+    peer_ = request.host + ":" + std::to_string(request.port);
+    conn_ = std::make_unique<Connection>(*this, request.host, request.port, std::min(timeout, 30.0));
     runEventsUntil([&] { return !conn_ || conn_->connected() || conn_->failed(); }, timeout);
     if (!conn_ || !conn_->connected()) {
       if (conn_ && !conn_->failed())
@@ -68,11 +95,14 @@ void Session::open(const std::string& host, int port, std::uint32_t ranks, const
       query(response, timeout);
     }
     // Step 3: start the MPI job with the layout set so far.
-    if (ranks > 0 && maxRanks_ > 0 && ranks > maxRanks_)
-      throw TclError({"PVR", "ARGS", "RANKS"}, "-ranks " + std::to_string(ranks) + " is more than " + peer_ +
+    if (request.ranks > 0 && maxRanks_ > 0 && request.ranks > maxRanks_)
+      throw TclError({"PVR", "ARGS", "RANKS"}, "-ranks " + std::to_string(request.ranks) + " is more than " + peer_ +
                                                    " allows (" + std::to_string(maxRanks_) + ")");
-    const auto ready = query(proto::SessionOpen{ranks, settings_.clusters}, std::max(timeout, 120.0));
-    const auto* r = std::get_if<proto::SessionReady>(&ready.front());
+    // A batch system may hold the job in its queue: each progress report
+    // is printed and gives the job another full timeout.
+    const auto ready = query(proto::SessionOpen{request.ranks, settings_.clusters, request.account}, std::max(timeout, 120.0),
+                             printQueueProgress);
+    const auto* r = std::get_if<proto::SessionReady>(&ready.back());
     if (!r) throw TclError({"PVR", "PROTOCOL", "UNEXPECTED_MESSAGE"}, peer_ + " did not answer SessionOpen with SessionReady");
     ranks_ = r->rankCount;
     layout_ = r->clusters;

@@ -4,6 +4,8 @@
 // view within 1e-5 (the job writes its float frames with --dump-frames),
 // in order, for each layout of the session; failures injected on one rank
 // (--fail-once STEP@RANK) reach the client and leave the session serving.
+// The master's first frame is JobHello with the job's PVR_JOB_SECRET; a
+// rank that cannot read the data names its host and the file.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -16,11 +18,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <thread>
 
 #include "camera.h"
@@ -41,6 +45,9 @@ using proto::ClusterRole;
 
 const fs::path kTmp = PVR_TEST_TMP;
 constexpr int kDims[3] = {40, 36, 33};
+// A directory of the data directory that the last rank of a job may be
+// made to see empty (Launch::hiddenFromLastRank).
+const fs::path kHidden = kTmp / "data" / "hidden";
 
 // A float32 raw volume with its JSON sidecar in `dir`.
 void writeVolume(const fs::path& dir) {
@@ -55,6 +62,15 @@ void writeVolume(const fs::path& dir) {
                                                         {"spacing", {1.0, 1.0, 1.25}},
                                                         {"raw_file", "phantom.raw"}}
                                              .dump();
+  // The same volume with its voxels under kHidden, which one rank may be
+  // made not to see.
+  fs::create_directories(kHidden);
+  fs::copy_file(dir / "phantom.raw", kHidden / "split.raw", fs::copy_options::overwrite_existing);
+  std::ofstream(dir / "split.json") << nlohmann::json{{"dims", {kDims[0], kDims[1], kDims[2]}},
+                                                      {"dtype", "float32"},
+                                                      {"spacing", {1.0, 1.0, 1.25}},
+                                                      {"raw_file", "hidden/split.raw"}}
+                                           .dump();
 }
 
 const char* kScene = R"({
@@ -62,10 +78,34 @@ const char* kScene = R"({
   "image": {"width": 64, "height": 64, "background": [0, 0, 0, 1]},
   "shading": {"enabled": true}})";
 
-// The handler's side of one job.
+// What pvrd would hand a job: a 64-hex-digit one-time secret.
+const std::string kSecret = "00112233445566778899aabbccddeeff00112233445566778899aabbccddeeff";
+
+// This host's name, as every rank of a job on it reports it.
+std::string thisHost() {
+  char name[256] = {};
+  REQUIRE(::gethostname(name, sizeof name - 1) == 0);
+  return name;
+}
+
+// True when this process may make mount namespaces (root, or a system
+// that allows unprivileged ones).
+bool canUnshareMounts() { return std::system("unshare -m true 2>/dev/null") == 0; }
+
+// How the handler starts a job besides its rank count and options.
+struct Launch {
+  std::optional<std::string> secret = kSecret;  // PVR_JOB_SECRET; nullopt: not set
+  // The last rank runs in a mount namespace of its own where kHidden is an
+  // empty tmpfs: a host of a cluster whose copy of the data lacks files.
+  bool hiddenFromLastRank = false;
+};
+
+// The handler's side of one job. The constructor checks the master's
+// first frame: JobHello with the secret the job was given.
 class Job {
  public:
-  Job(int ranks, const std::vector<std::string>& extra) {
+  // `extra`: more pvr-node options.
+  explicit Job(int ranks, const std::vector<std::string>& extra = {}, const Launch& launch = {}) {
     dumpDir_ = kTmp / ("frames-" + std::to_string(ranks) + "-" + std::to_string(::getpid()));
     fs::remove_all(dumpDir_);
     fs::create_directories(dumpDir_);
@@ -77,16 +117,32 @@ class Job {
     REQUIRE(::listen(listen_, 1) == 0);
     socklen_t len = sizeof addr;
     ::getsockname(listen_, reinterpret_cast<sockaddr*>(&addr), &len);
-    std::vector<std::string> args{PVR_MPIRUN, "--oversubscribe", "--bind-to", "none", "-np", std::to_string(ranks),
-                                  PVR_NODE_PATH, "--server", "--connect",
+    std::vector<std::string> node{PVR_NODE_PATH, "--server", "--connect",
                                   "127.0.0.1:" + std::to_string(ntohs(addr.sin_port)), "--data-dir",
                                   (kTmp / "data").string(), "--dump-frames", dumpDir_.string()};
-    args.insert(args.end(), extra.begin(), extra.end());
+    node.insert(node.end(), extra.begin(), extra.end());
+    // As pvrd does: the secret in mpirun's environment and passed on with
+    // -x (a remote rank 0 would not inherit it otherwise), never in argv.
+    std::vector<std::string> args{PVR_MPIRUN, "--oversubscribe", "--bind-to", "none"};
+    if (launch.secret) args.insert(args.end(), {"-x", "PVR_JOB_SECRET"});
+    if (launch.hiddenFromLastRank) {
+      // Two application contexts: ranks 0 .. N-2 as usual, then rank N-1
+      // through unshare, which mounts the empty tmpfs and execs pvr-node.
+      args.insert(args.end(), {"-np", std::to_string(ranks - 1)});
+      args.insert(args.end(), node.begin(), node.end());
+      args.insert(args.end(), {":", "-np", "1", "unshare", "-m", "sh", "-c",
+                               "mount -t tmpfs pvr-test-hidden \"$0\" && exec \"$@\"", kHidden.string()});
+    } else {
+      args.insert(args.end(), {"-np", std::to_string(ranks)});
+    }
+    args.insert(args.end(), node.begin(), node.end());
     pid_ = ::fork();
     if (pid_ == 0) {
       ::setpgid(0, 0);
       ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
       ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+      if (launch.secret) ::setenv("PVR_JOB_SECRET", launch.secret->c_str(), 1);
+      else ::unsetenv("PVR_JOB_SECRET");
       std::vector<char*> argv;
       for (auto& a : args) argv.push_back(a.data());
       argv.push_back(nullptr);
@@ -98,6 +154,12 @@ class Job {
     REQUIRE(::poll(&p, 1, 60000) == 1);
     fd_ = ::accept4(listen_, nullptr, nullptr, SOCK_CLOEXEC);
     REQUIRE(fd_ >= 0);
+    // The first frame: the secret, answering no request.
+    auto hello = receive();
+    REQUIRE(hello);
+    REQUIRE(std::holds_alternative<proto::JobHello>(hello->message));
+    CHECK(hello->info.requestId == 0);
+    CHECK(std::get<proto::JobHello>(hello->message).secret == launch.secret.value_or(""));
   }
   ~Job() {
     if (fd_ >= 0) ::close(fd_);
@@ -285,7 +347,7 @@ TEST_CASE_METHOD(Fixture, "clusters, groups and a compositing cluster all render
   Job job(4, {"--fail-once", "render@2"});
   job.send(proto::Hello{"runtime test"});
   job.expect<proto::Welcome>();
-  job.send(proto::SessionOpen{4, {}});
+  job.send(proto::SessionOpen{4, {}, ""});
   const auto ready = job.expect<proto::SessionReady>();
   REQUIRE(ready.clusters.size() == 1);
   CHECK(ready.clusters[0].ranks == 4);
@@ -296,7 +358,7 @@ TEST_CASE_METHOD(Fixture, "clusters, groups and a compositing cluster all render
   // the next render works.
   job.send(proto::RenderFrame{});
   const auto e = job.expectError();
-  CHECK(e.text.find("rank 2: injected failure in render") != std::string::npos);
+  CHECK_THAT(e.text, Catch::Contains("rank 2 on " + thisHost() + ": injected failure in render"));
 
   SECTION("one cluster compositing itself; memory and latency reports") {
     const auto id = job.send(proto::RenderFrame{});
@@ -372,7 +434,7 @@ TEST_CASE_METHOD(Fixture, "clusters, groups and a compositing cluster all render
 
 TEST_CASE_METHOD(Fixture, "a failure on a rank that sends to a compositing cluster, or on a compositing rank, reaches the client") {
   Job job(4, {"--fail-once", "render@1", "--fail-once", "composite@2"});
-  job.send(proto::SessionOpen{4, {{ClusterRole::kRender, 3, 0}, {ClusterRole::kComposite, 1, 0}}});
+  job.send(proto::SessionOpen{4, {{ClusterRole::kRender, 3, 0}, {ClusterRole::kComposite, 1, 0}}, ""});
   job.expect<proto::SessionReady>();
   job.send(proto::SetScene{"phantom.json", kScene});
   job.expect<proto::Ok>();
@@ -380,13 +442,13 @@ TEST_CASE_METHOD(Fixture, "a failure on a rank that sends to a compositing clust
   // Ranks 0-2 render and send their sub-images to rank 3, which sends the
   // band to the collector: rank 1's failure travels with its sub-image.
   job.send(proto::RenderFrame{});
-  CHECK_THAT(job.expectError().text, Catch::Contains("rank 1: injected failure in render"));
+  CHECK_THAT(job.expectError().text, Catch::Contains("rank 1 on " + thisHost() + ": injected failure in render"));
   // Ranks 2 and 3 composite: rank 2 fails, still takes its run and rank
   // 3's image, and sends the failure as the band.
   job.send(proto::SetLayout{{{ClusterRole::kRender, 2, 0}, {ClusterRole::kComposite, 2, 0}}});
   job.expect<proto::SessionReady>();
   job.send(proto::RenderFrame{});
-  CHECK_THAT(job.expectError().text, Catch::Contains("rank 2: injected failure in composite"));
+  CHECK_THAT(job.expectError().text, Catch::Contains("rank 2 on " + thisHost() + ": injected failure in composite"));
   const auto id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 2, 12});
   checkSequence(job, id, 3, 12, ref);
   CHECK(job.close());
@@ -394,7 +456,7 @@ TEST_CASE_METHOD(Fixture, "a failure on a rank that sends to a compositing clust
 
 TEST_CASE_METHOD(Fixture, "scene patches are checked whole before and after the dataset, and status reports the session") {
   Job job(2, {});
-  job.send(proto::SessionOpen{2, {}});
+  job.send(proto::SessionOpen{2, {}, ""});
   job.expect<proto::SessionReady>();
 
   // Before any dataset: the lists a client offers and the settings.
@@ -408,6 +470,7 @@ TEST_CASE_METHOD(Fixture, "scene patches are checked whole before and after the 
   CHECK(status["decompositions"] == "kd balanced");
   CHECK(status["strategy"] == "binary-swap");
   CHECK(status["decomposition"] == "kd");
+  CHECK(status["hosts"] == thisHost() + " " + thisHost());
   for (const char* key : {"camera_eye", "image_size", "bounds", "value_range", "transfer_function"})
     CHECK(status.count(key) == 0);
 
@@ -458,9 +521,41 @@ TEST_CASE_METHOD(Fixture, "scene patches are checked whole before and after the 
   CHECK(job.close());
 }
 
+TEST_CASE_METHOD(Fixture, "without PVR_JOB_SECRET the master still sends JobHello first, with an empty secret") {
+  // The constructor checks the empty secret; pvrd would refuse it and
+  // close, this handler goes on to show the job is otherwise the same.
+  Job job(2, {}, {.secret = std::nullopt});
+  job.send(proto::SessionOpen{2, {}, ""});
+  job.expect<proto::SessionReady>();
+  CHECK(job.close());
+}
+
+TEST_CASE_METHOD(Fixture, "a rank whose host lacks the data names its host and the file, and the session serves on") {
+  if (!canUnshareMounts()) {
+    WARN("skipped: this process may not make mount namespaces (unshare -m), so no rank can be given its own view of the data");
+    return;
+  }
+  Job job(2, {}, {.hiddenFromLastRank = true});
+  job.send(proto::SessionOpen{2, {}, ""});
+  job.expect<proto::SessionReady>();
+  // Rank 1 sees hidden/ empty: split.json's voxels are not there for it.
+  job.send(proto::SetScene{"split.json", kScene});
+  const auto e = job.expectError();
+  CHECK(e.code == proto::ErrorCode::kIo);
+  const std::string raw = (fs::canonical(kTmp / "data") / "hidden" / "split.raw").string();
+  CHECK_THAT(e.text, Catch::StartsWith("rank 1 on " + thisHost() + ": ") && Catch::Contains(raw));
+  // The next request works: a dataset every rank sees, rendered.
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  const Reference ref(nlohmann::json::object());
+  const auto id = job.send(proto::RenderFrame{});
+  checkSequence(job, id, 1, 1, ref);
+  CHECK(job.close());
+}
+
 TEST_CASE_METHOD(Fixture, "a rank killed mid-sequence: the handler side sees the end and nothing is left running") {
   Job job(3, {});
-  job.send(proto::SessionOpen{3, {}});
+  job.send(proto::SessionOpen{3, {}, ""});
   job.expect<proto::SessionReady>();
   job.send(proto::SetScene{"phantom.json", kScene});
   job.expect<proto::Ok>();
