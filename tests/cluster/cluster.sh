@@ -19,6 +19,7 @@
 #   cluster.sh up           create everything (state under $PVR_CLUSTER_DIR)
 #   cluster.sh down         kill every process on the hosts, remove everything
 #   cluster.sh exec H CMD   run CMD on host H with $PVR_CLUSTER_DIR/env.sh applied
+#   cluster.sh boot H       start a compute host's daemons again (after a test killed them)
 #   cluster.sh veth-bytes H the bytes H sent + received on its veth (one number)
 #
 # PVR_CLUSTER_DIR (default /tmp/pvr-cluster) holds: env.sh (Open MPI over
@@ -113,8 +114,9 @@ write_names() {
   for h in "${COMPUTE[@]}"; do echo "$h slots=1"; done >"$DIR/hostfile"
 }
 
-# Host keys per host, one root key pair for every login; sshd on h1..h3.
-start_sshd() {
+# Host keys per host, one root key pair for every login, an ssh_config that
+# names the hosts (so /etc/hosts need not), known_hosts: no prompt ever.
+write_ssh() {
   local ssh=$DIR/ssh h
   mkdir -p "$ssh"
   chmod 700 "$ssh"
@@ -123,9 +125,10 @@ start_sshd() {
   : >"$ssh/known_hosts"
   {
     for h in "${HOSTS[@]}"; do printf 'Host %s\n  HostName %s\n' "$h" "$(address "$h")"; done
-    # BatchMode: never a prompt. ServerAlive*: a host that vanishes (veth
-    # down) ends the ssh session, and so Open MPI's daemon on it, within ~6 s.
-    cat <<EOF
+    # BatchMode: never a prompt. ServerAlive*: a host that vanishes without
+    # closing its connections (veth down) ends the ssh session, and so Open
+    # MPI's daemon on it, within ~6 s.
+    cat <<EOF2
 Host *
   User root
   IdentityFile $ssh/id_ed25519
@@ -138,14 +141,14 @@ Host *
   ServerAliveInterval 2
   ServerAliveCountMax 3
   LogLevel ERROR
-EOF
+EOF2
   } >"$ssh/ssh_config"
   for h in "${COMPUTE[@]}"; do
     ssh-keygen -q -t ed25519 -N '' -C "$h" -f "$ssh/host_$h"
     echo "$h,$(address "$h") $(cut -d' ' -f1,2 "$ssh/host_$h.pub")" >>"$ssh/known_hosts"
     # StrictModes no: the keys live under /tmp, which is world-writable, and
     # StrictModes refuses an authorized_keys file below such a directory.
-    cat >"$ssh/sshd_config.$h" <<EOF
+    cat >"$ssh/sshd_config.$h" <<EOF2
 Port 22
 ListenAddress $(address "$h")
 HostKey $ssh/host_$h
@@ -160,15 +163,18 @@ StrictModes no
 PrintMotd no
 X11Forwarding no
 MaxStartups 64
-EOF
-    on "$h" /usr/sbin/sshd -f "$ssh/sshd_config.$h" -E "$DIR/log/sshd.$h.log" ||
-      die "sshd on $h did not start (see $DIR/log/sshd.$h.log)"
+EOF2
   done
-  for h in "${COMPUTE[@]}"; do
-    # The first packets between namespaces: a failure here may also be the
-    # bridge dropping them (bridge netfilter, /proc/sys/net/bridge).
-    wait_for "ssh from h0 to $h ($(address "$h"))" 10 on h0 ssh -F "$ssh/ssh_config" "$h" true
-  done
+}
+
+# start_sshd HOST: sshd on HOST, and wait until h0 logs in there.
+start_sshd() {
+  local h=$1
+  on "$h" /usr/sbin/sshd -f "$DIR/ssh/sshd_config.$h" -E "$DIR/log/sshd.$h.log" ||
+    die "sshd on $h did not start (see $DIR/log/sshd.$h.log)"
+  # The first packets between namespaces: a failure here may also be the
+  # bridge dropping them (bridge netfilter, /proc/sys/net/bridge).
+  wait_for "ssh from h0 to $h ($(address "$h"))" 10 on h0 ssh -F "$DIR/ssh/ssh_config" "$h" true
 }
 
 # wait_for WHAT SECONDS CMD...: retries CMD until it succeeds.
@@ -220,25 +226,28 @@ start_slurm() {
   fi
   write_slurm_conf
   : >"$slurm/plugstack.conf"
-  export SLURM_CONF=$slurm/slurm.conf
-  if ! on h0 slurmctld -c -L "$DIR/log/slurmctld.log" 2>>"$DIR/log/slurmctld.log"; then
+  if ! SLURM_CONF=$slurm/slurm.conf on h0 slurmctld -c -L "$DIR/log/slurmctld.log" 2>>"$DIR/log/slurmctld.log"; then
     slurm_unavailable "slurmctld did not start: $(tail -n 1 "$DIR/log/slurmctld.log")"
     return 0
   fi
   local h
   for h in "${COMPUTE[@]}"; do
-    if ! on "$h" slurmd -N "$h" -L "$DIR/log/slurmd.$h.log" 2>>"$DIR/log/slurmd.$h.log"; then
+    if ! start_slurmd "$h"; then
       slurm_unavailable "slurmd on $h did not start: $(tail -n 1 "$DIR/log/slurmd.$h.log")"
       return 0
     fi
   done
   local i idle=0
   for ((i = 0; i < 100; i++)); do
-    idle=$(on h0 sinfo -h -N -t idle -o %N 2>/dev/null | sort -u | wc -l) || idle=0
+    idle=$(SLURM_CONF=$slurm/slurm.conf on h0 sinfo -h -N -t idle -o %N 2>/dev/null | sort -u | wc -l) || idle=0
     [ "$idle" -eq ${#COMPUTE[@]} ] && return 0
     sleep 0.2
   done
-  slurm_unavailable "only $idle of ${#COMPUTE[@]} slurmd registered idle with slurmctld in 20 s: $(on h0 sinfo -h -N -o '%N %t %E' 2>&1 | paste -sd';')"
+  slurm_unavailable "only $idle of ${#COMPUTE[@]} slurmd registered idle with slurmctld in 20 s: $(SLURM_CONF=$slurm/slurm.conf on h0 sinfo -h -N -o '%N %t %E' 2>&1 | paste -sd';')"
+}
+
+start_slurmd() {
+  SLURM_CONF=$DIR/slurm/slurm.conf on "$1" slurmd -N "$1" -L "$DIR/log/slurmd.$1.log" 2>>"$DIR/log/slurmd.$1.log"
 }
 
 slurm_unavailable() {
@@ -298,7 +307,9 @@ up() {
   write_names
   make_network
   write_env
-  start_sshd
+  write_ssh
+  local h
+  for h in "${COMPUTE[@]}"; do start_sshd "$h"; done
   start_slurm
   trap - ERR EXIT
   echo "cluster.sh: up: hosts ${HOSTS[*]} on $SUBNET.0/24; source $DIR/env.sh; hostfile $DIR/hostfile" >&2
@@ -348,6 +359,19 @@ exec_on() {
   exec "${HOSTCMD[@]}" "$@"
 }
 
+# boot HOST: a compute host that lost its processes (a test killed them)
+# starts its daemons again: sshd, and slurmd when Slurm is up.
+boot() {
+  valid_host "$1"
+  [[ " ${COMPUTE[*]} " == *" $1 "* ]] || die "boot: $1 is not a compute host (${COMPUTE[*]})"
+  [ -f "$DIR/.pvr-cluster" ] || die "no cluster in $DIR (run: $SELF up)"
+  [ -z "$(ip netns pids "$(namespace "$1")")" ] || die "boot: $1 still runs processes"
+  start_sshd "$1"
+  if [ -f "$DIR/slurm/slurm.conf" ] && [ ! -f "$DIR/slurm.unavailable" ]; then
+    start_slurmd "$1" || die "slurmd on $1 did not start again (see $DIR/log/slurmd.$1.log)"
+  fi
+}
+
 veth_bytes() {
   valid_host "$1"
   local v
@@ -359,6 +383,7 @@ case "${1:-}" in
   up) up ;;
   down) down ;;
   exec) shift; exec_on "$@" ;;
+  boot) boot "${2:?usage: cluster.sh boot HOST}" ;;
   veth-bytes) veth_bytes "${2:?usage: cluster.sh veth-bytes HOST}" ;;
-  *) die "usage: cluster.sh up|down|exec HOST CMD...|veth-bytes HOST" ;;
+  *) die "usage: cluster.sh up|down|exec HOST CMD...|boot HOST|veth-bytes HOST" ;;
 esac

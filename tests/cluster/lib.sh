@@ -25,6 +25,7 @@ cluster_up() {
   for p in "$PVRD" "$PVR_NODE" "$PVRSH" "$PVR_MAKE_VOLUME"; do
     [ -x "$p" ] || fail "$p is not built"
   done
+  command -v idiff >/dev/null || fail "idiff (package openimageio-tools) compares the frames; it is not installed"
   PVR_CLUSTER_DIR=$(mktemp -d "${TMPDIR:-/tmp}/pvr-cluster.XXXXXX")
   export PVR_CLUSTER_DIR
   trap cluster_down EXIT
@@ -43,6 +44,18 @@ cluster_down() {
 }
 
 on() { "$CLUSTER" exec "$@"; }
+
+# wait_until SECONDS WHAT CMD...: retries CMD until it succeeds; fails with
+# WHAT after SECONDS.
+wait_until() {
+  local seconds=$1 what=$2 i
+  shift 2
+  for ((i = 0; i < seconds * 5; i++)); do
+    "$@" && return 0
+    sleep 0.2
+  done
+  fail "$what (waited ${seconds}s)"
+}
 
 # needs_slurm: skips the test with cluster.sh's reason when Slurm is not up.
 needs_slurm() {
