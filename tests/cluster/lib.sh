@@ -111,14 +111,15 @@ no_job_processes_within() {
 }
 
 # start_pvrd NAME ARGS...: pvrd on h0 listening on 127.0.0.1:0 of h0 with
-# the cluster's data; sets PORT_<NAME>. Its log: $PVR_CLUSTER_DIR/pvrd.NAME.log.
+# the data in $PVRD_DATA (default: the cluster's, make_data); sets
+# PORT_<NAME>. Its log: $PVR_CLUSTER_DIR/pvrd.NAME.log.
 pvrd_pids=()
 start_pvrd() {
   local name=$1
   shift
   local out=$PVR_CLUSTER_DIR/pvrd.$name.out log=$PVR_CLUSTER_DIR/pvrd.$name.log
   : >"$out"
-  on h0 "$PVRD" --listen 127.0.0.1:0 --data-dir "$PVR_CLUSTER_DIR/data" --node "$PVR_NODE" --max-ranks 4 "$@" \
+  "$CLUSTER" exec h0 "$PVRD" --listen 127.0.0.1:0 --data-dir "${PVRD_DATA:-$PVR_CLUSTER_DIR/data}" --node "$PVR_NODE" --max-ranks 4 "$@" \
     >"$out" 2>"$log" &
   pvrd_pids+=($!)
   local i port=""
