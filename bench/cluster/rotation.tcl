@@ -12,15 +12,14 @@
 # last arrival over N) and the mean of each phase, and with -veth the bytes
 # per frame through that veth during the rotation (the mini-cluster's hosts
 # share the machine's /sys, so its counters are readable from h0).
-array set opt {-host "" -tag "" -csv "" -ranks 2 -frames 36 -size 512 -preset "" -veth ""
-               -dataset ct_head_cranium/ct_head_cranium.json}
-foreach {k v} $argv {
-    if {![info exists opt($k)]} {
-        puts stderr "rotation.tcl: unknown option $k"
-        exit 2
-    }
-    set opt($k) $v
+set defaults {-host "" -tag "" -csv "" -ranks 2 -frames 36 -size 512 -preset "" -veth ""
+              -dataset ct_head_cranium/ct_head_cranium.json}
+set unknown [lmap k [dict keys $argv] {expr {[dict exists $defaults $k] ? [continue] : $k}}]
+if {[llength $unknown]} {
+    puts stderr "rotation.tcl: unknown options $unknown (known: [dict keys $defaults])"
+    exit 2
 }
+array set opt [dict merge $defaults $argv]
 set ::pvr::progress 0
 set phases {dist rend comp comm send}
 

@@ -5,12 +5,14 @@
 # host, and pvrd, still running, serves the next session on all three hosts
 # once h2 is back.
 #
-# Needs pvrd --advertise and the node's `hosts` status entry (issue 10).
+# pvrd runs without --advertise: its default, the local address of the
+# route towards the hostfile's first host (h1), is h0's 10.213.7.10.
+# Needs that default and the node's `hosts` status entry (issue 10).
 source "$(dirname "$0")/lib.sh"
 cluster_up
 make_data >/dev/null
 dataset=marschner_lobb/marschner_lobb.json
-start_pvrd hosts --hostfile "$PVR_CLUSTER_DIR/hostfile" --advertise 10.213.7.10
+start_pvrd hosts --hostfile "$PVR_CLUSTER_DIR/hostfile"
 pvrd_pid=${pvrd_pids[0]}
 
 note "a long rotation on h1..h3; h2 dies after its third frame"
