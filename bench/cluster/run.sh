@@ -20,7 +20,8 @@
 set -euo pipefail
 bench_dir=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$bench_dir/../.." && pwd)
-export PVR_BUILD=$(cd "${1:-$root/build}" && pwd)
+PVR_BUILD=$(cd "${1:-$root/build}" && pwd)
+export PVR_BUILD
 data=$(cd "$root/../shared/data" && pwd)
 out=$root/bench/results/cluster
 name=${PVR_BENCH_NAME:-rotation}

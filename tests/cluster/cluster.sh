@@ -75,6 +75,8 @@ check_machine() {
   for p in ip unshare nsenter ssh sshd ssh-keygen mpirun; do
     command -v "$p" >/dev/null || [ -x "/usr/sbin/$p" ] || skip "needs $p (packages iproute2, util-linux, openssh-server, openmpi-bin)"
   done
+  unshare --uts --mount --propagation private true 2>/dev/null ||
+    skip "cannot create UTS and mount namespaces (unshare --uts --mount refused)"
   if ip netns list 2>/dev/null | grep -q '^pvr-h'; then
     die "a cluster is up already (namespaces $(ip netns list | grep -o '^pvr-h[0-9]' | paste -sd' ')); run: $SELF down"
   fi

@@ -24,7 +24,7 @@ third_frame() {
   [ -e "$marker" ]
 }
 wait_until 30 "no third frame" third_frame
-[ -n "$(job_processes | grep '^h2 .* pvr-node$')" ] || fail "no rank runs on h2: $(job_processes | paste -sd';')"
+job_processes | grep -q '^h2 [0-9]* pvr-node$' || fail "no rank runs on h2: $(job_processes | paste -sd';')"
 killed_at=$(date +%s%3N)
 ip netns pids pvr-h2 | xargs -r kill -KILL
 wait $client || fail "the rotation did not fail: $(cat "$PVR_CLUSTER_DIR/lost.out")"

@@ -1,3 +1,4 @@
+# shellcheck shell=bash
 # Shared by the mini-cluster tests (sourced): brings the cluster up for the
 # test and down at its exit whatever happens, starts pvrd and pvrsh on h0,
 # and the checks the tests share. Programs come from the environment that
