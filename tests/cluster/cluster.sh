@@ -21,6 +21,8 @@
 #   cluster.sh exec H CMD   run CMD on host H with $PVR_CLUSTER_DIR/env.sh applied
 #   cluster.sh boot H       start a compute host's daemons again (after a test killed them)
 #   cluster.sh veth-bytes H the bytes H sent + received on its veth (one number)
+#   cluster.sh compute-bytes  the bytes that went between compute hosts h1..h3
+# (The hosts share the machine's /sys: these two work on a host as well.)
 #
 # PVR_CLUSTER_DIR (default /tmp/pvr-cluster) holds: env.sh (Open MPI over
 # ssh, SLURM_CONF), hostfile (h1..h3, one slot each), hosts, ssh/ (keys,
@@ -381,11 +383,23 @@ veth_bytes() {
   echo $(($(cat "/sys/class/net/$v/statistics/rx_bytes") + $(cat "/sys/class/net/$v/statistics/tx_bytes")))
 }
 
+# compute_bytes: bytes carried between the compute hosts so far. A frame
+# between two compute hosts crosses two of their veths; one between h0 and
+# a compute host crosses h0's veth and one other. So the sum over the
+# compute hosts minus h0's counts the compute-to-compute frames twice.
+# (Only ranks talk there: ssh and Open MPI's daemons talk to h0.)
+compute_bytes() {
+  local sum=0 h
+  for h in "${COMPUTE[@]}"; do sum=$((sum + $(veth_bytes "$h"))); done
+  echo $(((sum - $(veth_bytes h0)) / 2))
+}
+
 case "${1:-}" in
   up) up ;;
   down) down ;;
   exec) shift; exec_on "$@" ;;
   boot) boot "${2:?usage: cluster.sh boot HOST}" ;;
   veth-bytes) veth_bytes "${2:?usage: cluster.sh veth-bytes HOST}" ;;
-  *) die "usage: cluster.sh up|down|exec HOST CMD...|boot HOST|veth-bytes HOST" ;;
+  compute-bytes) compute_bytes ;;
+  *) die "usage: cluster.sh up|down|exec HOST CMD...|boot HOST|veth-bytes HOST|compute-bytes" ;;
 esac

@@ -24,7 +24,7 @@ third_frame() {
   [ -e "$marker" ]
 }
 wait_until 30 "no third frame" third_frame
-job_processes | grep -q '^h2 [0-9]* pvr-node$' || fail "no rank runs on h2: $(job_processes | paste -sd';')"
+job_processes | grep '^h2 [0-9]* pvr-node$' >/dev/null || fail "no rank runs on h2: $(job_processes | paste -sd';')"
 killed_at=$(date +%s%3N)
 ip netns pids pvr-h2 | xargs -r kill -KILL
 wait $client || fail "the rotation did not fail: $(cat "$PVR_CLUSTER_DIR/lost.out")"
@@ -32,7 +32,7 @@ wait $client || fail "the rotation did not fail: $(cat "$PVR_CLUSTER_DIR/lost.ou
 out=$(cat "$PVR_CLUSTER_DIR/lost.out")
 error_at=$(sed -n 's/^error_at //p' <<<"$out")
 code=$(sed -n 's/^errorcode //p' <<<"$out")
-note "client error after $((error_at - killed_at)) ms: $code: $(sed -n 's/^message //p' <<<"$out")"
+note "client error after $((error_at - killed_at)) ms: $code: $(sed -n '/^message /,$p' <<<"$out" | cut -c1-200)"
 [ "$code" = "PVR REMOTE RANK_FAILED" ] || fail "the client got '$code', not PVR REMOTE RANK_FAILED: $out"
 [ $((error_at - killed_at)) -le 10000 ] || fail "the error came $((error_at - killed_at)) ms after the host died (limit 10 s)"
 sed -n '/^message /,$p' <<<"$out" | grep -qw h2 || fail "the error does not name the lost host h2: $out"

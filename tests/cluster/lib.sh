@@ -14,6 +14,7 @@ PVRSH=${PVRSH:-$build/pvrsh/pvrsh}
 PVR_MAKE_VOLUME=${PVR_MAKE_VOLUME:-$build/tools/pvr-make-volume}
 export TCLLIBPATH=${TCLLIBPATH:-$build/lib}
 CLUSTER=$here/cluster.sh
+export PVR_CLUSTER_SH=$CLUSTER  # rotation.tcl counts bytes with it
 readonly SKIP=77
 
 fail() { echo "FAIL: $*" >&2; exit 1; }
@@ -73,16 +74,7 @@ make_data() {
   echo "$PVR_CLUSTER_DIR/data"
 }
 
-# compute_bytes: bytes carried between the compute hosts h1..h3 so far.
-# Every frame between two compute hosts crosses two of their veths; a frame
-# between h0 and a compute host crosses h0's veth and one other. So the sum
-# over h1..h3 minus h0's counts the compute-to-compute frames twice. Only
-# ranks talk to each other there: ssh and Open MPI's daemons talk to h0.
-compute_bytes() {
-  local sum=0 h
-  for h in h1 h2 h3; do sum=$((sum + $("$CLUSTER" veth-bytes "$h"))); done
-  echo $(((sum - $("$CLUSTER" veth-bytes h0)) / 2))
-}
+compute_bytes() { "$CLUSTER" compute-bytes; }
 
 # job_processes: "host pid command" of every job process (mpirun, Open MPI's
 # daemon, pvr-node, srun, salloc, slurmstepd) left on any host.

@@ -6,6 +6,8 @@
 # Frames go to DIR/r_00000.png, ... Prints on stdout
 #   order F F ...   the frame numbers in the order their callbacks ran
 #   hosts H H ...   the server's status entry `hosts` (every rank's host)
+#   bytes N         the bytes that went between compute hosts during the
+#                   rotation (`$PVR_CLUSTER_SH compute-bytes` before and after)
 # Any error (open, a server error during wait) exits non-zero with its
 # message and -errorcode on stderr.
 set openOptions [lassign $argv server ranks dataset dir frames]
@@ -19,9 +21,12 @@ pvr_session :r
 :r open $server -ranks $ranks -timeout 60 {*}$openOptions
 :r set -dataset $dataset -imagesz 96,96 -background 0,0,0 \
     -tf {0 0 0 0 0  0.3 0.2 0.4 1 0.05  0.6 1 0.8 0.2 0.3  1 1 1 1 0.8}
+set before [exec $env(PVR_CLUSTER_SH) compute-bytes]
 :r render rotate 0,0,1 0,[expr {$frames - 1}]:$frames
 :r wait -timeout 60
+set bytes [expr {[exec $env(PVR_CLUSTER_SH) compute-bytes] - $before}]
 set remote [dict get [:r list status] remote]
 puts "order $order"
+puts "bytes $bytes"
 puts "hosts [expr {[dict exists $remote hosts] ? [dict get $remote hosts] : "(no hosts entry)"}]"
 :r close
