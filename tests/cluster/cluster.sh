@@ -30,9 +30,9 @@
 # When Slurm cannot run here, `up` says why, writes the reason to
 # $PVR_CLUSTER_DIR/slurm.unavailable and still brings up the rest.
 #
-# Exit status 77: this machine does not allow the cluster (not root, no
-# `ip netns`, no bridge or veth); the message says which. A failed `up`
-# removes what it made.
+# Exit status 77: this machine does not allow the cluster (not root, a
+# program missing, no UTS or mount namespaces, no network namespace, bridge
+# or veth); the message says which. A failed `up` removes what it made.
 set -euo pipefail
 
 readonly HOSTS=(h0 h1 h2 h3)
@@ -308,6 +308,8 @@ up() {
   : >"$DIR/.pvr-cluster"  # `down` removes only a directory that has this
   mkdir -p "$DIR/log" "$DIR/run"
   trap 'echo "cluster.sh: up failed; removing what it made" >&2; down_quietly' ERR EXIT
+  trap 'exit 130' INT
+  trap 'exit 143' TERM
   write_names
   make_network
   write_env
@@ -315,7 +317,7 @@ up() {
   local h
   for h in "${COMPUTE[@]}"; do start_sshd "$h"; done
   start_slurm
-  trap - ERR EXIT
+  trap - ERR EXIT INT TERM
   echo "cluster.sh: up: hosts ${HOSTS[*]} on $SUBNET.0/24; source $DIR/env.sh; hostfile $DIR/hostfile" >&2
 }
 
@@ -344,7 +346,7 @@ down() {
 }
 
 down_quietly() {
-  trap - ERR EXIT
+  trap - ERR EXIT INT TERM
   down 2>/dev/null || true
 }
 

@@ -20,8 +20,11 @@ readonly SKIP=77
 fail() { echo "FAIL: $*" >&2; exit 1; }
 note() { echo "-- $*" >&2; }
 
-# cluster_up: a fresh PVR_CLUSTER_DIR, the cluster up, down at exit. A
-# machine that cannot host it skips the test (exit 77, cluster.sh says why).
+# cluster_up: a fresh PVR_CLUSTER_DIR, the cluster up, down at exit (also
+# on SIGINT and SIGTERM, which would skip the EXIT trap). A machine that
+# cannot host it skips the test (exit 77, cluster.sh says why). A cluster
+# that was up before (cluster.sh refuses a second) is left alone.
+cluster_ours=0
 cluster_up() {
   local p
   for p in "$PVRD" "$PVR_NODE" "$PVRSH" "$PVR_MAKE_VOLUME"; do
@@ -31,15 +34,18 @@ cluster_up() {
   PVR_CLUSTER_DIR=$(mktemp -d "${TMPDIR:-/tmp}/pvr-cluster.XXXXXX")
   export PVR_CLUSTER_DIR
   trap cluster_down EXIT
+  trap 'exit 130' INT
+  trap 'exit 143' TERM
   local status=0
   "$CLUSTER" up || status=$?
   [ $status -eq 0 ] || exit $status
+  cluster_ours=1
 }
 
 cluster_down() {
   local status=$?
   stop_pvrds
-  "$CLUSTER" down || true
+  [ $cluster_ours -eq 0 ] || "$CLUSTER" down || true
   # cluster.sh down removed the directory; if `up` never made it, we do.
   [ -n "${PVR_CLUSTER_DIR:-}" ] && rm -rf "$PVR_CLUSTER_DIR"
   exit $status
