@@ -90,6 +90,9 @@ check_machine() {
 no_ipv6() { echo 1 >"/proc/sys/net/ipv6/conf/$1/disable_ipv6"; }
 
 make_network() {
+  # `ip netns add` makes its directory (a bind mount of itself) if missing;
+  # `down` removes it again then, when no namespace is left in it.
+  [ -d /run/netns ] || : >"$DIR/.made-run-netns"
   ip link add "$BRIDGE" type bridge 2>/dev/null || skip "cannot create bridge $BRIDGE (ip link add type bridge refused)"
   no_ipv6 "$BRIDGE"
   ip link set "$BRIDGE" up
@@ -342,6 +345,10 @@ down() {
     ip netns del "$ns" 2>/dev/null || true
   done
   ip link del "$BRIDGE" 2>/dev/null || true
+  if [ -f "$DIR/.made-run-netns" ] && [ -z "$(ls -A /run/netns 2>/dev/null)" ]; then
+    while mountpoint -q /run/netns; do umount /run/netns; done
+    rmdir /run/netns
+  fi
   if [ -f "$DIR/.pvr-cluster" ]; then rm -rf "$DIR"; fi
 }
 
