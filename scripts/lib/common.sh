@@ -14,6 +14,7 @@ PVR_PACKAGES=(
   catch2 nlohmann-json3-dev libteem-dev libnifti2-dev
   clang libclang-rt-14-dev
   gnuplot-nox xvfb xauth
+  iproute2 openssh-server munge slurm-wlm
 )
 
 pvr_install_missing() {
