@@ -18,15 +18,14 @@ namespace {
 
 // The one-time secret pvrd hands the job it launches (mpirun -x), which the
 // master proves itself with on the connect-back (docs/runtime.md).
-constexpr const char* kJobSecretVariable = "PVR_JOB_SECRET";
 
 // The secret, taken out of this process's environment so that nothing this
 // rank starts inherits it. Called before MPI starts its threads: unsetenv
 // must not race with a getenv.
 std::string takeJobSecret() {
-  const char* value = std::getenv(kJobSecretVariable);
+  const char* value = std::getenv(proto::kJobSecretVariable);
   std::string secret = value ? value : "";
-  ::unsetenv(kJobSecretVariable);
+  ::unsetenv(proto::kJobSecretVariable);
   return secret;
 }
 
@@ -49,7 +48,7 @@ int runServer(const ServerOptions& options) {
       // has checked the secret, and refuses an empty one.
       if (secret.empty())
         std::fprintf(stderr, "pvr-node: rank 0: %s is not set (pvrd sets it for the job it launches); "
-                     "the connect-back will be refused\n", kJobSecretVariable);
+                     "the connect-back will be refused\n", proto::kJobSecretVariable);
       link->send(proto::JobHello{secret}, 0);
     } catch (const Error& e) {
       std::fprintf(stderr, "pvr-node: rank 0: %s\n", e.what());

@@ -154,6 +154,10 @@ struct Close {
 // Master rank -> session handler, the first frame on the connect-back: the
 // one-time secret pvrd handed to the job in its environment, so that the
 // handler relays nothing for a connection that is not the job it launched.
+// The environment variable that carries the secret to the job: pvrd sets
+// it (and exports it to every rank with mpirun -x), the master reads it.
+inline constexpr const char* kJobSecretVariable = "PVR_JOB_SECRET";
+
 struct JobHello {
   static constexpr WireInfo kWire{0x08, "JobHello", &Limits::maxControlPayload};
   std::string secret;  // PVR_JOB_SECRET as the job received it

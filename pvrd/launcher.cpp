@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include "mpirun_launcher.h"
+#include "pvr_protocol.h"
 #include "slurm_launcher.h"
 
 namespace pvr::daemon {
@@ -23,7 +24,7 @@ constexpr LauncherEntry kLaunchers[] = {
 
 bool Launcher::start(const JobSpec& spec, std::string& error) {
   session_ = spec.session;
-  JobProcess::Environment environment{{"PVR_JOB_SECRET", spec.secret}};
+  JobProcess::Environment environment{{proto::kJobSecretVariable, spec.secret}};
   if (::geteuid() == 0)
     environment.insert(environment.end(), {{"OMPI_ALLOW_RUN_AS_ROOT", "1"}, {"OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1"}});
   return process_.start(command(spec), environment, deathSignal(), error);

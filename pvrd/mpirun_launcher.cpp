@@ -2,6 +2,8 @@
 
 #include <regex>
 
+#include "pvr_protocol.h"
+
 namespace pvr::daemon {
 namespace {
 
@@ -29,7 +31,7 @@ std::vector<std::string> mpirunCommand(const JobSpec& spec, const DaemonOptions&
   std::vector<std::string> args{options.mpirun, "--oversubscribe", "--bind-to", "none", "-np", std::to_string(spec.ranks)};
   if (withHostfile && !options.hostfile.empty()) args.insert(args.end(), {"--hostfile", options.hostfile});
   // -x hands the variable to every rank, rank 0 included, wherever it runs.
-  args.insert(args.end(), {"-x", "PVR_JOB_SECRET", spec.nodePath, "--server", "--connect", spec.connect, "--data-dir",
+  args.insert(args.end(), {"-x", proto::kJobSecretVariable, spec.nodePath, "--server", "--connect", spec.connect, "--data-dir",
                            spec.dataDir});
   return args;
 }

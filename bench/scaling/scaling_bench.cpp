@@ -165,7 +165,7 @@ int main(int argc, char** argv) {
   s.fd = ::accept(listenFd, nullptr, nullptr);
   if (s.fd < 0) die("the master did not connect");
 
-  s.send(proto::SessionOpen{std::uint32_t(np), layout.empty() ? std::vector<proto::ClusterSpec>{} : parseLayout(layout)});
+  s.send(proto::SessionOpen{std::uint32_t(np), layout.empty() ? std::vector<proto::ClusterSpec>{} : parseLayout(layout), ""});
   s.receive();
   s.send(proto::SetScene{dataset, scene.dump()});
   s.receive();

@@ -27,7 +27,17 @@ pvr_install_missing() {
   local sudo=""
   [ "$(id -u)" -eq 0 ] || sudo="sudo"
   $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  # openssh-server, munge and slurm-wlm would start the machine's own
+  # daemons on install; the tests start their own inside namespaces. A
+  # policy-rc.d that refuses every start keeps them down (only while we install).
+  local policy=/usr/sbin/policy-rc.d made_policy=""
+  if [ ! -e "$policy" ]; then
+    printf '#!/bin/sh\nexit 101\n' | $sudo tee "$policy" >/dev/null && $sudo chmod +x "$policy" && made_policy=1
+  fi
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" || {
+    [ -n "$made_policy" ] && $sudo rm -f "$policy"; return 1; }
+  [ -n "$made_policy" ] && $sudo rm -f "$policy"
+  return 0
 }
 
 # Open MPI refuses to run as root unless told; our jobs are local and ours.

@@ -15,15 +15,25 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A data directory holding one (empty) dataset file, as a real path.
-std::string dataDir() {
-  static const fs::path dir = [] {
+// A data directory holding one (empty) dataset file, as a real path;
+// removed when the test program ends.
+struct ScratchDataDir {
+  fs::path path;
+  ScratchDataDir() {
     const fs::path d = fs::temp_directory_path() / ("pvr-scene-patch-" + std::to_string(::getpid()));
     fs::create_directories(d);
     std::ofstream(d / "ct.json") << "{}";
-    return fs::canonical(d);
-  }();
-  return dir.string();
+    path = fs::canonical(d);
+  }
+  ~ScratchDataDir() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
+std::string dataDir() {
+  static const ScratchDataDir dir;
+  return dir.path.string();
 }
 
 SessionScene accepted(const SessionScene& current, const proto::SetScene& request) {

@@ -136,7 +136,7 @@ TEST_CASE("extreme field values round-trip bit for bit") {
 
 TEST_CASE("empty strings, lists and unknown error codes round-trip") {
   const std::vector<Message> messages{
-      Hello{""}, SetScene{"", ""}, SessionOpen{0, {}}, StatusReply{{{"", ""}}}, CatalogReply{{}},
+      Hello{""}, SetScene{"", ""}, SessionOpen{0, {}, ""}, StatusReply{{{"", ""}}}, CatalogReply{{}},
       // A code from a newer peer passes through unchanged.
       ErrorMessage{static_cast<ErrorCode>(999), "from the future"},
       ImageFrame{0, 1, 1, PixelFormat::kRgba8, Compression::kZlib, {}, {}}};
