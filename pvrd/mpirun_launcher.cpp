@@ -43,7 +43,20 @@ int rankFromMpirunOutput(const std::string& text) {
   return -1;
 }
 
+std::string lostHostFromMpirunOutput(const std::string& text) {
+  // Open MPI 4.1 names the host whose daemon it lost ("Remote daemon:
+  // [[...],2] on node h2") or whose peer went away ("Peer host: h2").
+  static const std::regex daemon(R"(Remote daemon:[^\n]*on node\s+([^\s]+))");
+  static const std::regex peer(R"(Peer host:\s*([^\s]+))");
+  std::smatch m;
+  if (std::regex_search(text, m, daemon) || std::regex_search(text, m, peer)) return m[1].str();
+  return {};
+}
+
 std::string mpirunEndText(const std::string& why, const std::string& outputTail) {
+  const std::string host = lostHostFromMpirunOutput(outputTail);
+  if (!host.empty())
+    return "host " + host + " was lost: Open MPI lost contact with it and ended the rendering job (" + why + ")";
   const int rank = rankFromMpirunOutput(outputTail);
   if (rank >= 0) return "rank " + std::to_string(rank) + " failed: the rendering job ended (" + why + ")";
   const std::string tail =

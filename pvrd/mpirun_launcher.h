@@ -23,6 +23,9 @@ std::vector<std::string> mpirunCommand(const JobSpec& spec, const DaemonOptions&
 // or -1.
 int rankFromMpirunOutput(const std::string& text);
 
+// The host Open MPI says it lost contact with ("" when its output names none).
+std::string lostHostFromMpirunOutput(const std::string& text);
+
 // The client's text for an MPI job that ended because of `why`: the rank
 // when mpirun's output names it, otherwise the end of that output.
 std::string mpirunEndText(const std::string& why, const std::string& outputTail);

@@ -24,7 +24,9 @@ third_frame() {
   [ -e "$marker" ]
 }
 wait_until 30 "no third frame" third_frame
-job_processes | grep '^h2 [0-9]* pvr-node$' >/dev/null || fail "no rank runs on h2: $(job_processes | paste -sd';')"
+# One listing, read twice: a pipe into grep could end the listing early.
+procs=$(job_processes)
+grep -q '^h2 [0-9]* pvr-node$' <<<"$procs" || fail "no rank runs on h2: $(paste -sd';' <<<"$procs")"
 killed_at=$(date +%s%3N)
 ip netns pids pvr-h2 | xargs -r kill -KILL
 wait $client || fail "the rotation did not fail: $(cat "$PVR_CLUSTER_DIR/lost.out")"

@@ -158,3 +158,19 @@ TEST_CASE("the failed rank is read from mpirun's message") {
   CHECK(rankFromMpirunOutput("mpirun noticed that process rank 1 with PID 4242 on node x exited on signal 9 (Killed).") == 1);
   CHECK(rankFromMpirunOutput("something else") == -1);
 }
+
+TEST_CASE("a host Open MPI lost contact with is named in the job's end text") {
+  // Open MPI 4.1's words when a remote daemon vanishes (ORTE help text).
+  const std::string lostDaemon =
+      "--------------------------------------------------------------------------\n"
+      "ORTE has lost communication with a remote daemon.\n\n"
+      "  HNP daemon   : [[41029,0],0] on node h0\n"
+      "  Remote daemon: [[41029,0],2] on node h2\n\n"
+      "This is usually due to either a failure of the TCP network\n";
+  CHECK(lostHostFromMpirunOutput(lostDaemon) == "h2");
+  CHECK(lostHostFromMpirunOutput("  Local host: h1\n  Peer host:  h3\n") == "h3");
+  CHECK(lostHostFromMpirunOutput("mpirun noticed that process rank 1 with PID 4242 on node x exited") == "");
+  const std::string text = mpirunEndText("mpirun exited with status 1", lostDaemon);
+  CHECK_THAT(text, Catch::StartsWith("host h2 was lost"));
+  CHECK_THAT(text, Catch::Contains("mpirun exited with status 1"));
+}
