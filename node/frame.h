@@ -24,7 +24,7 @@ namespace pvr::node {
 using VolumeOpener = std::function<std::unique_ptr<core::VolumeSource>(const core::VolumeSpec&)>;
 
 struct FrameOptions {
-  std::string strategy = "binary-swap";
+  std::string strategy{composite::kDefaultStrategy};
   composite::StrategyParams strategyParams;
   Decomposition decomposition = Decomposition::kKd;
   std::optional<double> earlyTermination;  // overrides the scene's sampling.early_termination

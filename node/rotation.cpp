@@ -7,16 +7,6 @@
 
 namespace pvr::node {
 
-namespace {
-
-// v turned by `angle` radians about unit axis k (Rodrigues).
-core::Vec3 turn(const core::Vec3& v, const core::Vec3& k, double angle) {
-  const double c = std::cos(angle), s = std::sin(angle);
-  return v * c + cross(k, v) * s + k * (dot(k, v) * (1 - c));
-}
-
-}  // namespace
-
 Rotation::Rotation(const core::CameraSpec& base, const proto::RenderRotation& r)
     : base_(base), start_(r.start), stepsPerTurn_(r.stepsPerTurn) {
   if (const auto refusal = r.check(proto::Limits{}))
@@ -30,8 +20,8 @@ Rotation::Rotation(const core::CameraSpec& base, const proto::RenderRotation& r)
 core::CameraSpec Rotation::camera(int index) const {
   const double angle = 2 * std::numbers::pi * double(start_ + index) / double(stepsPerTurn_);
   core::CameraSpec c = base_;
-  c.eye = base_.lookAt + turn(base_.eye - base_.lookAt, axis_, angle);
-  c.up = turn(base_.up, axis_, angle);
+  c.eye = base_.lookAt + core::rotateAbout(base_.eye - base_.lookAt, axis_, angle);
+  c.up = core::rotateAbout(base_.up, axis_, angle);
   return c;
 }
 

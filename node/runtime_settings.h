@@ -10,11 +10,12 @@
 
 #include "distribute.h"
 #include "pvr_protocol.h"
+#include "strategy.h"
 
 namespace pvr::node {
 
 struct RuntimeSettings {
-  std::string strategy = "binary-swap";  // self-compositing clusters; a registered strategy
+  std::string strategy{composite::kDefaultStrategy};  // self-compositing clusters; a registered strategy
   Decomposition decomposition = Decomposition::kKd;
   double rebalanceThreshold = 1.2;  // max/mean content per rank that triggers a rebalance
   proto::PixelFormat format = proto::PixelFormat::kRgba8;

@@ -36,6 +36,12 @@ template <typename T>
 T length(Vec3T<T> a) { return std::sqrt(dot(a, a)); }
 template <typename T>
 Vec3T<T> normalize(Vec3T<T> a) { return a / length(a); }
+// v turned right-handedly by `radians` about the unit axis k (Rodrigues).
+template <typename T>
+Vec3T<T> rotateAbout(Vec3T<T> v, Vec3T<T> k, T radians) {
+  const T c = std::cos(radians), s = std::sin(radians);
+  return v * c + cross(k, v) * s + k * (dot(k, v) * (1 - c));
+}
 
 // Integer node coordinates (voxel indices).
 struct IVec3 {

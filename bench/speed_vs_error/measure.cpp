@@ -194,9 +194,7 @@ core::CameraSpec azimuth(const core::CameraSpec& camera, double degrees) {
   const core::Vec3 forward = normalize(-offset);
   const core::Vec3 k = normalize(camera.up - forward * dot(camera.up, forward));
   const double a = degrees * std::acos(-1.0) / 180;
-  // Rodrigues: right-handed rotation of the offset about k.
-  const core::Vec3 turned = offset * std::cos(a) + cross(k, offset) * std::sin(a) +
-                            k * (dot(k, offset) * (1 - std::cos(a)));
+  const core::Vec3 turned = core::rotateAbout(offset, k, a);
   core::CameraSpec out = camera;
   out.eye = camera.lookAt + turned;
   out.up = k;

@@ -82,6 +82,9 @@ struct StrategyEntry {
   std::unique_ptr<Strategy> (*make)(const StrategyParams&);
 };
 
+// The strategy a session or a batch run uses unless told otherwise.
+inline constexpr std::string_view kDefaultStrategy = "binary-swap";
+
 // Every registered strategy (strategies.cpp), in the order to list them.
 const std::vector<StrategyEntry>& strategies();
 // Throws pvr::Error (kInvalidArgument) naming the known strategies.
