@@ -3,6 +3,8 @@
 // the fake master) and a fake scancel that notes the job ids it is given.
 #include <catch2/catch.hpp>
 
+#include <sstream>
+
 #include "daemon_harness.h"
 #include "fake_master.h"
 
@@ -43,6 +45,20 @@ void expectQueued(Client& c, std::uint32_t id, const std::string& job, const std
         std::vector<proto::KeyValue>{{"state", "queued"}, {"batch_job", job}, {"reason", reason}});
 }
 
+// The processes of `pids` whose parent is not in `pids`.
+std::vector<pid_t> outermost(const std::vector<pid_t>& pids) {
+  std::vector<pid_t> out;
+  for (pid_t p : pids) {
+    std::ifstream stat("/proc/" + std::to_string(p) + "/stat");
+    std::string s((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+    const auto close = s.rfind(')');
+    pid_t parent = 0;
+    if (close != std::string::npos) std::istringstream(s.substr(close + 4)) >> parent;  // ") S PPID"
+    if (std::find(pids.begin(), pids.end(), parent) == pids.end()) out.push_back(p);
+  }
+  return out;
+}
+
 }  // namespace
 
 TEST_CASE("slurm: the queue's progress reaches the client, status says queued, then the session works and the allocation is cancelled at its end") {
@@ -61,7 +77,10 @@ TEST_CASE("slurm: the queue's progress reaches the client, status says queued, t
   CHECK(std::get<proto::StatusReply>(reply->message).entries.front() == proto::KeyValue{"state", "queued"});
 
   // salloc got the partition, time, account and job name as one word each.
-  const auto salloc = jobProcesses(f.dataDir);
+  // (The fake salloc's polling forks a shell child that shows the same
+  // command line until it execs sleep: keep only the process whose parent
+  // is not itself one of the job's.)
+  const auto salloc = outermost(jobProcesses(f.dataDir));
   REQUIRE(salloc.size() == 1);
   const auto argv = procEntries(salloc[0], "cmdline");
   for (const std::string& word : std::vector<std::string>{"--ntasks=2", "--partition=vis", "--time=10", "--account=proj_1.a-b",
