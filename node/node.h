@@ -84,7 +84,12 @@ struct NodeState {
   std::optional<core::KdTree> tree;  // over my cluster's ranks
   core::Brick brick;
   std::unique_ptr<core::BrickRenderer> renderer;
-  double pendingDist = 0;  // (re)distribution time not yet charged to a frame
+  // Time not yet charged to a frame (FrameTiming): reading bricks,
+  // preprocessing them (value range, macrocells, classification), and the
+  // rest of a (re)distribution (decomposition, scatter).
+  double pendingRead = 0;
+  double pendingPreprocess = 0;
+  double pendingDist = 0;
   int rebalances = 0;
   double imbalance = 0;  // max/mean content per rank at the last transfer-function change (master's cluster)
   // The data's finite values, min and max over every brick; set by every

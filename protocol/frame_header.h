@@ -36,7 +36,11 @@ inline constexpr std::uint16_t kKnownFlags = kFlagFinal;
 // which image sizes do).
 inline constexpr std::uint32_t kMaxFrameBytes = 64u << 20;
 
-// The most frames one RenderRotation may ask for (end - start + 1).
+// Wire bytes of the FrameTiming record: seven f64 phases
+// (protocol_messages.h checks the struct against it).
+inline constexpr std::uint32_t kFrameTimingBytes = 7 * 8;
+
+// The most frames one RenderRotation or RenderTimeSteps may ask for.
 inline constexpr std::uint32_t kMaxRotationFrames = 100000;
 
 // Receiver-side limits, checked against the header before any payload byte
@@ -48,7 +52,7 @@ struct Limits {
   std::uint32_t maxControlPayload = 64u << 10;   // hello, auth, session, render, ...
   std::uint32_t maxTextPayload = 4u << 20;       // scene JSON, status, catalog, performance
   std::uint64_t maxImagePixels = 8192ull * 8192ull;  // width * height of an ImageFrame
-  std::uint32_t maxRotationFrames = kMaxRotationFrames;  // frames of one RenderRotation
+  std::uint32_t maxRotationFrames = kMaxRotationFrames;  // frames of one RenderRotation or RenderTimeSteps
 };
 
 struct FrameHeader {

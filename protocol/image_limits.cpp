@@ -6,8 +6,8 @@ namespace pvr::proto {
 
 std::uint64_t imageFramePayloadBytes(std::uint64_t width, std::uint64_t height, PixelFormat format) {
   // frame number, width, height (u32 each), format, compression (u8 each),
-  // five doubles of timing, u32 pixel byte count, then the pixels.
-  constexpr std::uint64_t kFixed = 3 * 4 + 2 * 1 + 5 * 8 + 4;
+  // the timing record, u32 pixel byte count, then the pixels.
+  constexpr std::uint64_t kFixed = 3 * 4 + 2 * 1 + kFrameTimingBytes + 4;
   return kFixed + width * height * channelCount(format);
 }
 

@@ -33,6 +33,20 @@ std::optional<ProtocolError> RenderRotation::check(const Limits& limits) const {
   return std::nullopt;
 }
 
+std::optional<ProtocolError> RenderTimeSteps::check(const Limits& limits) const {
+  const std::string steps = "time steps " + std::to_string(first) + " to " + std::to_string(last);
+  if (stride == 0) return ProtocolError{ErrorCode::kBadArgument, steps + " with stride 0; the stride must be at least 1"};
+  if (last < first) return ProtocolError{ErrorCode::kBadArgument, steps + ": the last step is below the first"};
+  const std::uint64_t frames = (std::uint64_t{last} - first) / stride + 1;
+  if (frames > limits.maxRotationFrames) {
+    return ProtocolError{ErrorCode::kLimitExceeded, steps + " ask for " + std::to_string(frames) +
+                                                        " frames, over the protocol's limit of " +
+                                                        std::to_string(limits.maxRotationFrames) +
+                                                        " frames per request"};
+  }
+  return std::nullopt;
+}
+
 std::optional<ProtocolError> ImageFrame::checkHead(std::uint64_t pixelBytes, const Limits& limits) const {
   const std::string size = std::to_string(width) + " x " + std::to_string(height);
   if (width == 0 || height == 0) {

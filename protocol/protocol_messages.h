@@ -42,12 +42,12 @@ struct WireInfo {
 enum class ClusterRole : std::uint8_t { kRender = 0, kComposite = 1, kCollector = 2 };
 enum class PixelFormat : std::uint8_t { kRgb8 = 0, kRgba8 = 1 };
 enum class Compression : std::uint8_t { kNone = 0, kRle = 1, kZlib = 2 };
-enum class PerformanceQuery : std::uint8_t { kMemory = 0, kCompositing = 1 };
+enum class PerformanceQuery : std::uint8_t { kMemory = 0, kCompositing = 1, kCache = 2 };
 
 constexpr bool isWireValue(ClusterRole v) { return v <= ClusterRole::kCollector; }
 constexpr bool isWireValue(PixelFormat v) { return v <= PixelFormat::kRgba8; }
 constexpr bool isWireValue(Compression v) { return v <= Compression::kZlib; }
-constexpr bool isWireValue(PerformanceQuery v) { return v <= PerformanceQuery::kCompositing; }
+constexpr bool isWireValue(PerformanceQuery v) { return v <= PerformanceQuery::kCache; }
 // Error codes pass through unchecked: a peer may know codes this build does not.
 constexpr bool isWireValue(ErrorCode) { return true; }
 
@@ -68,17 +68,34 @@ struct ClusterSpec {
   bool operator==(const ClusterSpec&) const = default;
 };
 
-// Where the time of one frame went, in seconds, as measured on the ranks.
+// Where the time of one frame went, in seconds, as measured on the ranks
+// (max over ranks per phase). The phases of a first frame add up: reading
+// the bricks, preprocessing them (value range, macrocell bounds, distance
+// field, classification), distributing (decomposition, scatter, view),
+// rendering, compositing, waiting, and the collector's send.
 struct FrameTiming {
+  double read = 0;         // reading brick voxels from the files
+  double preprocess = 0;   // value range, macrocells, distance field, classification
   double distribute = 0;   // sending view and bricks to the rendering clusters
   double render = 0;       // ray casting
   double composite = 0;    // compositing
   double communicate = 0;  // waiting on other ranks
   double send = 0;         // collector: conversion, compression and send
   static auto fields(auto& self) {
-    return std::tie(self.distribute, self.render, self.composite, self.communicate, self.send);
+    return std::tie(self.read, self.preprocess, self.distribute, self.render, self.composite, self.communicate,
+                    self.send);
   }
   bool operator==(const FrameTiming&) const = default;
+};
+static_assert(sizeof(FrameTiming) == kFrameTimingBytes, "FrameTiming's wire size is kFrameTimingBytes");
+
+// One dataset of the catalog: its name relative to the data directory and
+// its number of time steps (1 for a single volume).
+struct CatalogEntry {
+  std::string name;
+  std::uint32_t steps = 1;
+  static auto fields(auto& self) { return std::tie(self.name, self.steps); }
+  bool operator==(const CatalogEntry&) const = default;
 };
 
 struct KeyValue {
@@ -232,6 +249,24 @@ struct RenderRotation {
   bool operator==(const RenderRotation&) const = default;
 };
 
+// Client -> server: one frame per time step first, first + stride, ...
+// up to last (inclusive) of a time-series dataset, at the current view, in
+// order: frame k shows step first + k * stride. Steps are 0-based.
+struct RenderTimeSteps {
+  static constexpr WireInfo kWire{0x24, "RenderTimeSteps", &Limits::maxControlPayload};
+  std::uint32_t first = 0;
+  std::uint32_t last = 0;
+  std::uint32_t stride = 1;
+  static auto fields(auto& self) { return std::tie(self.first, self.last, self.stride); }
+  // stride >= 1 and first <= last (kBadArgument), at most
+  // limits.maxRotationFrames frames (kLimitExceeded). Whether the steps
+  // exist is the server's to check against the dataset.
+  std::optional<ProtocolError> check(const Limits& limits) const;
+  // (last - first) / stride + 1; meaningful once check() passed.
+  std::uint32_t frameCount() const { return (last - first) / stride + 1; }
+  bool operator==(const RenderTimeSteps&) const = default;
+};
+
 // Server -> client: one rendered frame.
 struct ImageFrame {
   static constexpr WireInfo kWire{0x22, "ImageFrame", &Limits::maxFrameBytes};
@@ -307,10 +342,10 @@ struct CatalogRequest {
   bool operator==(const CatalogRequest&) const = default;
 };
 
-// The dataset names the server can open, sorted.
+// The datasets the server can open, sorted by name; a time series once.
 struct CatalogReply {
   static constexpr WireInfo kWire{0x35, "CatalogReply", &Limits::maxTextPayload};
-  std::vector<std::string> datasets;
+  std::vector<CatalogEntry> datasets;
   static auto fields(auto& self) { return std::tie(self.datasets); }
   bool operator==(const CatalogReply&) const = default;
 };
@@ -320,7 +355,7 @@ struct CatalogReply {
 using Message = std::variant<
     Hello, Welcome, AuthChallenge, AuthResponse, Ok, ErrorMessage, Close, JobHello,
     SessionOpen, SessionReady, SetScene, SetLayout,
-    RenderFrame, RenderRotation, ImageFrame, Cancel,
+    RenderFrame, RenderRotation, RenderTimeSteps, ImageFrame, Cancel,
     StatusRequest, StatusReply, PerformanceRequest, PerformanceReply, CatalogRequest, CatalogReply>;
 
 }  // namespace pvr::proto

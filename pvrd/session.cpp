@@ -147,7 +147,9 @@ void Session::onClient(proto::Decoded frame) {
   if (std::holds_alternative<proto::JobHello>(m))
     return replyError(ErrorCode::kUnexpectedMessage, "JobHello is the rendering job's message, not a client's", id);
   if (std::holds_alternative<proto::CatalogRequest>(m)) {
-    sendClient(proto::CatalogReply{listDatasets(opt_.dataDir)}, id);
+    proto::CatalogReply reply;
+    for (auto& name : listDatasets(opt_.dataDir)) reply.datasets.push_back({std::move(name), 1});
+    sendClient(reply, id);
     return;
   }
   if (const auto* open = std::get_if<proto::SessionOpen>(&m)) return openSession(*open, id);

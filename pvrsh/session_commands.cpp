@@ -181,7 +181,8 @@ int listCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   Tcl_Obj* list = Tcl_NewListObj(0, nullptr);
   for (const auto& m : s.query(proto::CatalogRequest{}, 30))
     if (const auto* c = std::get_if<proto::CatalogReply>(&m))
-      for (const auto& name : c->datasets) Tcl_ListObjAppendElement(nullptr, list, Tcl_NewStringObj(name.c_str(), -1));
+      for (const auto& entry : c->datasets)
+        Tcl_ListObjAppendElement(nullptr, list, Tcl_NewStringObj(entry.name.c_str(), -1));
   Tcl_SetObjResult(interp, list);
   return TCL_OK;
 }

@@ -17,6 +17,13 @@ namespace pvr::core {
 
 // The finite values of a brick. Non-finite voxels (NaN, Inf) are counted, not
 // ranged: they classify as empty wherever they are sampled.
+// Seconds spent filling a brick: in I/O, and in preprocessing done while
+// the data was read (value range, macrocell bounds). Readers set it.
+struct LoadTimes {
+  double read = 0;
+  double preprocess = 0;
+};
+
 struct ValueRange {
   double min = 0;
   double max = 0;
@@ -57,6 +64,9 @@ class Brick {
   void updateValueRange();
   const ValueRange& valueRange() const { return range_; }
 
+  LoadTimes& loadTimes() { return loadTimes_; }
+  const LoadTimes& loadTimes() const { return loadTimes_; }
+
  private:
   GridGeometry grid_;
   ScalarType type_ = ScalarType::kUInt8;
@@ -64,6 +74,7 @@ class Brick {
   NodeBox stored_;
   std::vector<std::byte> data_;
   ValueRange range_;
+  LoadTimes loadTimes_;
 };
 
 // The part of `source` that a brick owning `owned` with `ghostLayers` layers

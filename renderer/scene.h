@@ -25,6 +25,7 @@ struct VolumeSpec {
   std::string procedural;  // a procedural volume name with
   IVec3 dims{64, 64, 64};  // its resolution
   std::optional<Vec3> spacing;  // procedural only: overrides the default isotropic spacing
+  int timestep = 0;             // 0-based step of a time series (the scene's "timestep")
 };
 
 // One control point: scalar -> linear RGB colour and opacity (per unit_distance).

@@ -29,6 +29,13 @@ class VolumeSource {
   virtual std::string describe() const = 0;
 
   Brick readAll() const { return readBox(grid().allNodes(), grid().allNodes()); }
+
+  // A time series is steps() volumes on one grid and scalar type: step(k)
+  // (0-based) is the k-th, stepTime(k) its time. A single volume is a series
+  // of one step, itself. readBox of a series reads its step 0.
+  virtual int steps() const { return 1; }
+  virtual double stepTime(int /*k*/) const { return 0; }
+  virtual const VolumeSource& step(int /*k*/) const { return *this; }
 };
 
 // A file format: `matches` looks at the path (extension), `open` reads the

@@ -62,7 +62,7 @@ TEST_CASE("end of stream between frames is clean, inside one is truncation") {
   CHECK_FALSE(clean.endOfStream().has_value());
 
   FrameDecoder cut;
-  const auto frame = encode(CatalogReply{{"a", "b"}}, 1);
+  const auto frame = encode(CatalogReply{{{"a", 1}, {"b", 1}}}, 1);
   cut.feed(std::span(frame).first(frame.size() - 1));
   REQUIRE(cut.endOfStream().has_value());
   CHECK(cut.error()->code == ErrorCode::kTruncatedFrame);

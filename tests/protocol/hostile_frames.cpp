@@ -29,7 +29,7 @@ std::vector<std::uint8_t> imagePayload(std::uint32_t width, std::uint32_t height
     w.integer(height);
     w.integer(format);
     w.integer(compression);
-    for (int i = 0; i < 5; ++i) w.f64(0.0);
+    for (std::size_t i = 0; i < sizeof(FrameTiming) / sizeof(double); ++i) w.f64(0.0);  // every phase
     w.lengthPrefixed(std::vector<std::uint8_t>(pixelBytes, 0x55));
   });
 }
@@ -130,8 +130,8 @@ std::vector<HostileCase> hostileCases() {
        "enumeration value 2"},
       {"compression 3", rawFrame({.type = imageType}, imagePayload(1, 1, 0, 3, 3)), ErrorCode::kMalformedPayload,
        "enumeration value 3"},
-      {"performance query 2", rawFrame({.type = PerformanceRequest::kWire.type}, {2, 0, 0, 0, 0}),
-       ErrorCode::kMalformedPayload, "enumeration value 2"},
+      {"performance query 3", rawFrame({.type = PerformanceRequest::kWire.type}, {3, 0, 0, 0, 0}),
+       ErrorCode::kMalformedPayload, "enumeration value 3"},
       {"uncompressed image one pixel byte short", rawFrame({.type = imageType}, imagePayload(2, 2, 0, 0, 11)),
        ErrorCode::kMalformedPayload, "needs 12 pixel bytes, got 11"},
       {"uncompressed image one pixel byte long", rawFrame({.type = imageType}, imagePayload(2, 2, 1, 0, 17)),
@@ -154,6 +154,12 @@ std::vector<HostileCase> hostileCases() {
        ErrorCode::kLimitExceeded, "limit of " + std::to_string(kMaxRotationFrames) + " frames"},
       {"rotation about the zero axis", encode(RenderRotation{{0, 0, 0}, 0, 1, 60}, 1), ErrorCode::kBadArgument,
        "not a finite nonzero vector"},
+      // Time-step requests (RenderTimeSteps::check).
+      {"time steps with stride 0", encode(RenderTimeSteps{0, 9, 0}, 1), ErrorCode::kBadArgument, "stride 0"},
+      {"time steps ending before they start", encode(RenderTimeSteps{5, 4, 1}, 1), ErrorCode::kBadArgument,
+       "the last step is below the first"},
+      {"time steps of one frame too many", encode(RenderTimeSteps{0, kMaxRotationFrames, 1}, 1),
+       ErrorCode::kLimitExceeded, "limit of " + std::to_string(kMaxRotationFrames) + " frames"},
   };
 }
 

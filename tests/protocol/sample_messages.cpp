@@ -47,6 +47,7 @@ std::vector<Message> sampleMessages() {
       SetLayout{{{ClusterRole::kRender, 32, 0}, {ClusterRole::kComposite, 31, 0}}},
       RenderFrame{},
       RenderRotation{{0, 1, 0}, 15, 59, 60},
+      RenderTimeSteps{0, 48, 2},
       sampleImage(),
       Cancel{42},
       StatusRequest{},
@@ -54,7 +55,7 @@ std::vector<Message> sampleMessages() {
       PerformanceRequest{PerformanceQuery::kCompositing, kAllClusters},
       PerformanceReply{PerformanceQuery::kMemory, R"({"clusters":[{"index":0,"bytes":16777216}]})"},
       CatalogRequest{},
-      CatalogReply{{"brain.slc", "marschner_lobb", "visible_human_256"}},
+      CatalogReply{{{"brain.slc", 1}, {"marschner_lobb", 1}, {"visible_human_256", 40}}},
   };
   return samples;
 }

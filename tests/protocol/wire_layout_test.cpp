@@ -29,7 +29,7 @@ TEST_CASE("strings are a u32 byte count then the bytes and booleans one byte") {
 }
 
 TEST_CASE("an ImageFrame payload follows the documented field order") {
-  ImageFrame image{5, 1, 2, PixelFormat::kRgba8, Compression::kRle, {1.0, 0, 0, 0, 0.5}, {9, 8, 7}};
+  ImageFrame image{5, 1, 2, PixelFormat::kRgba8, Compression::kRle, {1.0, 0, 0, 0, 0, 0, 0.5}, {9, 8, 7}};
   const auto frame = encode(image, 0);
   std::vector<std::uint8_t> expected;
   ByteWriter w(expected);
@@ -38,7 +38,7 @@ TEST_CASE("an ImageFrame payload follows the documented field order") {
   w.integer<std::uint32_t>(2);  // height
   w.integer<std::uint8_t>(1);   // RGBA
   w.integer<std::uint8_t>(1);   // RLE
-  for (double t : {1.0, 0.0, 0.0, 0.0, 0.5}) w.f64(t);
+  for (double t : {1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5}) w.f64(t);  // read .. send
   w.integer<std::uint32_t>(3);  // pixel byte count
   w.raw(std::vector<std::uint8_t>{9, 8, 7});
   CHECK(std::vector<std::uint8_t>(frame.begin() + kHeaderBytes, frame.end()) == expected);
