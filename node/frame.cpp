@@ -1,7 +1,14 @@
 #include "frame.h"
 
+#include <sys/resource.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 
 #include "camera.h"
 #include "raycast/raycaster.h"
@@ -33,11 +40,38 @@ std::vector<RankReport> gatherReports(const RankReport& mine, comm::Communicator
 
 }  // namespace
 
+double processAgeSeconds() {
+  // Field 22 of /proc/self/stat is the start time in clock ticks after boot,
+  // and CLOCK_BOOTTIME counts from boot too. The command name (field 2) may
+  // hold spaces, so the fields are counted after its closing parenthesis.
+  std::ifstream in("/proc/self/stat");
+  std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t close = stat.rfind(')');
+  timespec now{};
+  if (close == std::string::npos || ::clock_gettime(CLOCK_BOOTTIME, &now) != 0) return 0;
+  std::istringstream fields(stat.substr(close + 1));
+  std::string field;
+  for (int i = 3; i <= 22 && fields >> field; ++i) {
+    if (i < 22) continue;
+    const double started = std::stod(field) / double(::sysconf(_SC_CLK_TCK));
+    return std::max(0.0, double(now.tv_sec) + now.tv_nsec * 1e-9 - started);
+  }
+  return 0;
+}
+
+std::uint64_t peakRssBytes() {
+  rusage usage{};
+  if (::getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return std::uint64_t(usage.ru_maxrss) * 1024;  // Linux counts kilobytes
+}
+
 PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& options,
                            comm::Communicator& comm) {
   PreparedFrame prepared;
   FrameResult& result = prepared.frame;
   RankReport& report = prepared.report;
+
+  report.start = processAgeSeconds();
 
   // Open the volume, resolve the scene, check the strategy's name.
   const auto distStart = std::chrono::steady_clock::now();
@@ -64,14 +98,20 @@ PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& optio
   result.readPartially = prepared.bricks.readPartially;
   result.rootReadBytes = prepared.bricks.rootReadBytes;
   report.brickBytes = prepared.bricks.brick.byteSize();
-  report.dist = secondsSince(distStart);
+  // The reader's seconds are inside the distribution's; dist keeps the rest.
+  const core::LoadTimes& loaded = prepared.bricks.brick.loadTimes();
+  report.read = loaded.read;
+  report.dist = std::max(0.0, secondsSince(distStart) - loaded.read - loaded.preprocess);
 
-  // Render my brick into its screen rectangle.
+  // Preprocess (macrocell grid, classification) and render my brick into
+  // its screen rectangle.
   runAgreed(comm, [&] {
     prepared.camera.emplace(result.scene.camera, result.scene.image.width, result.scene.image.height);
     core::ThreadPool pool(options.threads);
+    const auto prepStart = std::chrono::steady_clock::now();
     core::BrickRenderer renderer(prepared.bricks.brick);
     renderer.classify(result.scene.transfer, renderOptions);
+    report.prep = loaded.preprocess + secondsSince(prepStart);
     const auto start = std::chrono::steady_clock::now();
     prepared.partial = renderer.render(*prepared.camera, renderOptions, pool);
     report.rend = secondsSince(start);
@@ -96,6 +136,7 @@ FrameResult compositeFrame(const PreparedFrame& prepared, const FrameOptions& op
   report.comp = composite.stats.computeSeconds;
   report.comm = composite.stats.communicationSeconds;
   report.send = composite.stats.gatherSeconds;
+  report.peakRssBytes = peakRssBytes();
   result.ranks = gatherReports(report, comm);
   if (comm.rank() == 0) result.image = std::move(composite.image);
   return result;

@@ -35,15 +35,22 @@ struct FrameOptions {
   VolumeOpener openVolume;
 };
 
-// One rank's account of a frame; the columns of Table 1 of the paper.
+// One rank's account of a frame: the columns of Table 1 of the paper, with
+// the distribution split into its phases so that a first frame's time adds
+// up. On a rank the phases follow one another in this order.
 struct RankReport {
-  double dist = 0;  // open, decompose, read or scatter bricks
-  double rend = 0;  // ray casting the brick
-  double comp = 0;  // compositing computation
-  double comm = 0;  // compositing communication
-  double send = 0;  // gathering the tiles at rank 0
+  double start = 0;  // process start (exec by mpirun) to the frame's start: MPI init, host names, scene
+  double read = 0;   // reading this rank's voxels (the reader's I/O seconds, Brick::loadTimes)
+  double prep = 0;   // preprocessing: the reader's (value range, macrocell bounds while reading)
+                     // plus building the renderer's macrocell grid and classifying
+  double dist = 0;   // the rest of distribution: open, decompose, scatter
+  double rend = 0;   // ray casting the brick
+  double comp = 0;   // compositing computation
+  double comm = 0;   // compositing communication
+  double send = 0;   // gathering the tiles at rank 0
   composite::CompositeStats composite;
-  std::uint64_t brickBytes = 0;  // voxel bytes this rank holds (owned + ghosts)
+  std::uint64_t brickBytes = 0;    // voxel bytes this rank holds (owned + ghosts)
+  std::uint64_t peakRssBytes = 0;  // the process's peak resident memory at the end of the frame
 };
 
 struct FrameResult {
@@ -62,6 +69,11 @@ struct FrameResult {
 FrameResult renderFrame(const core::Scene& scene, const FrameOptions& options,
                         comm::Communicator& comm);
 
+// Seconds since this process started (0 where /proc cannot tell), and its
+// peak resident memory so far (getrusage): the report's start and RSS.
+double processAgeSeconds();
+std::uint64_t peakRssBytes();
+
 // renderFrame in its two halves, for benchmarks that composite one
 // rendering many ways: prepareFrame opens, distributes and renders (dist,
 // rend); compositeFrame composites with options.strategy and options.codec.
@@ -70,7 +82,7 @@ struct PreparedFrame {
   Distribution bricks;
   core::Image partial;    // this rank's rendered brick
   std::optional<core::Camera> camera;
-  RankReport report;      // dist, rend, brickBytes
+  RankReport report;      // start, read, prep, dist, rend, brickBytes
 };
 PreparedFrame prepareFrame(const core::Scene& scene, const FrameOptions& options,
                            comm::Communicator& comm);

@@ -13,9 +13,12 @@
 // (the usage text lists the registered strategies and decompositions).
 // Every rank reads its own brick (or rank 0 scatters when the format cannot
 // read part of a file), renders it, and the ranks composite; rank 0 writes
-// the image and prints the hosts of the ranks and the time breakdown. Any
+// the image and prints the hosts of the ranks and the time breakdown
+// (every phase from process start to the written image, report.h) with
+// each rank's peak resident memory. Any
 // rank's failure makes every rank exit 1 with the first failure printed
 // once, by rank 0, naming the rank and its host.
+#include <chrono>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -136,9 +139,13 @@ int run(const Args& args, const std::vector<std::string>& hosts, comm::Communica
   const node::FrameResult result = node::renderFrame(scene, args.frame, comm);
   comm::runAgreed(comm, [&] {
     if (comm.rank() != 0) return;
+    const auto writeStart = std::chrono::steady_clock::now();
     core::writeImage(result.image, result.scene.image.background, args.output);
-    if (!args.stats.empty()) node::writeStatsCsv(args.stats, result, args.frame);
-    std::printf("%s: %s", args.output.c_str(), node::formatReport(result, args.frame, hosts).c_str());
+    node::OutputTimes output;
+    output.write = std::chrono::duration<double>(std::chrono::steady_clock::now() - writeStart).count();
+    output.wall = node::processAgeSeconds();
+    if (!args.stats.empty()) node::writeStatsCsv(args.stats, result, args.frame, output);
+    std::printf("%s: %s", args.output.c_str(), node::formatReport(result, args.frame, hosts, output).c_str());
   });
   return 0;
 }

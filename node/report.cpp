@@ -17,8 +17,12 @@ struct Column {
   std::function<double(const RankReport&)> value;
 };
 
+// The phases in the order they follow one another on every rank.
 std::vector<Column> timeColumns() {
-  return {{"dist", [](const RankReport& r) { return r.dist; }},
+  return {{"start", [](const RankReport& r) { return r.start; }},
+          {"read", [](const RankReport& r) { return r.read; }},
+          {"prep", [](const RankReport& r) { return r.prep; }},
+          {"dist", [](const RankReport& r) { return r.dist; }},
           {"rend", [](const RankReport& r) { return r.rend; }},
           {"comp", [](const RankReport& r) { return r.comp; }},
           {"comm", [](const RankReport& r) { return r.comm; }},
@@ -47,7 +51,7 @@ TrafficTotals sumTraffic(const std::vector<RankReport>& ranks) {
 }
 
 std::string formatReport(const FrameResult& result, const FrameOptions& options,
-                         const std::vector<std::string>& hosts) {
+                         const std::vector<std::string>& hosts, const OutputTimes& output) {
   const auto& ranks = result.ranks;
   const int n = int(ranks.size());
   std::string out;
@@ -56,6 +60,7 @@ std::string formatReport(const FrameResult& result, const FrameOptions& options,
               result.scene.image.width, result.scene.image.height);
   out += "hosts: " + hostRuns(hosts) + "\n";
   out += "time (s)    max       mean      min\n";
+  double sumOfMax = output.write;
   for (const Column& c : timeColumns()) {
     double mx = 0, sum = 0, mn = 1e300;
     for (const RankReport& r : ranks) {
@@ -63,8 +68,14 @@ std::string formatReport(const FrameResult& result, const FrameOptions& options,
       mn = std::min(mn, c.value(r));
       sum += c.value(r);
     }
+    sumOfMax += mx;
     out += line("%-8s %9.4f %9.4f %9.4f\n", c.name, mx, sum / n, mn);
   }
+  out += line("%-8s %9.4f   (rank 0 writes the image)\n", "write", output.write);
+  out += line("%-8s %9.4f   (phases follow one another on each rank; read and prep are the reader's "
+              "own seconds and overlap only where it preprocesses on other threads while reading)\n",
+              "sum", sumOfMax);
+  out += line("%-8s %9.4f   (rank 0, from its process start to the written image)\n", "wall", output.wall);
   const TrafficTotals traffic = sumTraffic(ranks);
   const std::uint64_t messages = traffic.messages, maxMessages = traffic.maxMessagesPerRank,
                       raw = traffic.rawBytes, encoded = traffic.encodedBytes, pixels = traffic.pixels,
@@ -84,14 +95,21 @@ std::string formatReport(const FrameResult& result, const FrameOptions& options,
               result.readPartially ? "each rank read its own brick" : "rank 0 read the volume and scattered");
   if (!result.readPartially)
     out += line("rank 0 held the whole volume (%.3f MB) while scattering\n", result.rootReadBytes * 1e-6);
+  out += "peak resident memory per rank (MB, and over its voxel bytes):";
+  for (int i = 0; i < n; ++i)
+    out += line("%s %d: %.1f (%.2fx)", i ? "," : "", i, ranks[i].peakRssBytes * 1e-6,
+                ranks[i].brickBytes ? double(ranks[i].peakRssBytes) / double(ranks[i].brickBytes) : 0.0);
+  out += "\n";
   return out;
 }
 
-void writeStatsCsv(const std::string& path, const FrameResult& result, const FrameOptions& options) {
+void writeStatsCsv(const std::string& path, const FrameResult& result, const FrameOptions& options,
+                   const OutputTimes& output) {
   std::ofstream out(path);
   if (!out) throw Error(ErrorCode::kIo, path + ": cannot open for writing");
   out << "rank,ranks,strategy,decomposition,width,height,dist,rend,comp,comm,send,messages,"
-         "raw_bytes,encoded_bytes,pixels_sent,gather_messages,gather_bytes,brick_bytes,volume_bytes\n";
+         "raw_bytes,encoded_bytes,pixels_sent,gather_messages,gather_bytes,brick_bytes,volume_bytes,"
+         "start,read,prep,write,wall,peak_rss_bytes\n";
   for (std::size_t i = 0; i < result.ranks.size(); ++i) {
     const RankReport& r = result.ranks[i];
     out << i << ',' << result.ranks.size() << ',' << options.strategy << ','
@@ -100,7 +118,8 @@ void writeStatsCsv(const std::string& path, const FrameResult& result, const Fra
         << ',' << r.send << ',' << r.composite.messagesSent << ',' << r.composite.rawBytesSent << ','
         << r.composite.encodedBytesSent << ',' << r.composite.pixelsSent << ','
         << r.composite.gatherMessagesSent << ',' << r.composite.gatherBytesSent << ',' << r.brickBytes
-        << ',' << result.volumeBytes << '\n';
+        << ',' << result.volumeBytes << ',' << r.start << ',' << r.read << ',' << r.prep << ','
+        << (i == 0 ? output.write : 0.0) << ',' << (i == 0 ? output.wall : 0.0) << ',' << r.peakRssBytes << '\n';
   }
   if (!out) throw Error(ErrorCode::kIo, path + ": write failed");
 }

@@ -25,27 +25,36 @@ void dumpFloat(const std::string& dir, std::uint32_t request, std::uint32_t fram
   std::fclose(f);
 }
 
-// A frame's phases from every rank's: dist, rend and comp are the slowest
-// rank's; comm is the longest a rank spent in compositing messages beyond
-// waiting for a slower rank's brick (a rank that finished rendering early
-// waits in its first exchange), so the phases add up to the frame's time
-// instead of counting the render imbalance twice.
+// Every rank's timings of a wave, flat: first the charges not yet made to
+// a frame (read, preprocess, distribute), then rend, comp, comm per slot.
+constexpr std::size_t kPending = 3, kPerSlot = 3;
+constexpr std::size_t kRead = 0, kPreprocess = 1, kDistribute = 2;
+constexpr std::size_t kRend = 0, kComp = 1, kComm = 2;
+std::size_t at(std::size_t slot, std::size_t phase) { return kPending + slot * kPerSlot + phase; }
+
+// A wave's phases from every rank's: read, preprocess, distribute, rend and
+// comp are the slowest rank's; comm is the longest a rank spent in
+// compositing messages beyond waiting for a slower rank's brick (a rank
+// that finished rendering early waits in its first exchange), so the
+// phases add up to the frame's time instead of counting the render
+// imbalance twice.
 std::vector<double> frameTimes(const std::vector<comm::Bytes>& perRank, std::size_t slots) {
+  const std::size_t count = at(slots, 0);
   std::vector<std::vector<double>> ranks;
   for (const comm::Bytes& b : perRank) {
-    if (b.size() != slots * 4 * sizeof(double)) throw Error(ErrorCode::kInternal, "wave timings of the wrong size");
-    std::vector<double> t(slots * 4);
+    if (b.size() != count * sizeof(double)) throw Error(ErrorCode::kInternal, "wave timings of the wrong size");
+    std::vector<double> t(count);
     std::memcpy(t.data(), b.data(), b.size());
     ranks.push_back(std::move(t));
   }
-  std::vector<double> out(slots * 4, 0.0);
+  std::vector<double> out(count, 0.0);
   for (const auto& t : ranks)
-    for (std::size_t i = 0; i < out.size(); ++i)
-      if (i % 4 != 3) out[i] = std::max(out[i], t[i]);
+    for (std::size_t i = 0; i < count; ++i)
+      if (i < kPending || (i - kPending) % kPerSlot != kComm) out[i] = std::max(out[i], t[i]);
   for (std::size_t s = 0; s < slots; ++s)
     for (const auto& t : ranks) {
-      const double waitForRender = out[s * 4 + 1] - t[s * 4 + 1];
-      out[s * 4 + 3] = std::max(out[s * 4 + 3], t[s * 4 + 3] - waitForRender);
+      const double waitForRender = out[at(s, kRend)] - t[at(s, kRend)];
+      out[at(s, kComm)] = std::max(out[at(s, kComm)], t[at(s, kComm)] - waitForRender);
     }
   return out;
 }
@@ -54,17 +63,21 @@ std::vector<double> frameTimes(const std::vector<comm::Bytes>& perRank, std::siz
 
 void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame,
                  std::optional<comm::Failure>& failure) {
-  // Timings of every rank, gathered: slot s holds rend, comp, comm at
-  // 4s+1..4s+3, and slot 0 the distribution at 0.
+  // Timings of every rank, gathered; the pending charges go to the wave's
+  // first frame.
   const std::size_t slots = state.wave.size();
-  std::vector<double> mine(slots * 4, 0.0);
-  for (std::size_t s = 0; s < slots; ++s) {
-    mine[s * 4 + 1] = state.wave[s].rend;
-    mine[s * 4 + 2] = state.wave[s].comp;
-    mine[s * 4 + 3] = state.wave[s].comm;
+  std::vector<double> mine(at(slots, 0), 0.0);
+  if (slots > 0) {
+    mine[kRead] = state.pendingRead;
+    mine[kPreprocess] = state.pendingPreprocess;
+    mine[kDistribute] = state.pendingDist;
+    state.pendingRead = state.pendingPreprocess = state.pendingDist = 0;
   }
-  if (slots > 0) mine[0] = state.pendingDist;
-  state.pendingDist = 0;
+  for (std::size_t s = 0; s < slots; ++s) {
+    mine[at(s, kRend)] = state.wave[s].rend;
+    mine[at(s, kComp)] = state.wave[s].comp;
+    mine[at(s, kComm)] = state.wave[s].comm;
+  }
   const std::vector<double> times = frameTimes(state.world.allGather(std::as_bytes(std::span(mine))), slots);
   if (state.world.rank() != 0 || failure) return;
 
@@ -83,10 +96,14 @@ void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFram
       out.height = std::uint32_t(height);
       out.format = state.settings.format;
       setFramePixels(out, frame, state.scene.image.background, state.settings.compression);
-      out.timing.distribute = s == 0 ? times[0] + state.commandSeconds : 0.0;
-      out.timing.render = times[s * 4 + 1];
-      out.timing.composite = times[s * 4 + 2];
-      out.timing.communicate = times[s * 4 + 3];
+      if (s == 0) {
+        out.timing.read = times[kRead];
+        out.timing.preprocess = times[kPreprocess];
+        out.timing.distribute = times[kDistribute] + state.commandSeconds;
+      }
+      out.timing.render = times[at(s, kRend)];
+      out.timing.composite = times[at(s, kComp)];
+      out.timing.communicate = times[at(s, kComm)];
       out.timing.send = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (state.sendFrame) state.sendFrame(std::move(out), number == lastFrame);
     }

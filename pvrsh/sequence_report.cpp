@@ -10,6 +10,22 @@
 
 namespace pvr::tcl {
 
+namespace {
+
+// A frame's phases in FrameTiming's order, named as the timing dicts and
+// the table name them (read, prep and dist are charged to the first frame
+// after a dataset load or redistribution).
+struct Phase {
+  const char* name;
+  double proto::FrameTiming::*value;
+};
+constexpr Phase kPhases[] = {{"read", &proto::FrameTiming::read},       {"prep", &proto::FrameTiming::preprocess},
+                             {"dist", &proto::FrameTiming::distribute}, {"rend", &proto::FrameTiming::render},
+                             {"comp", &proto::FrameTiming::composite},  {"comm", &proto::FrameTiming::communicate},
+                             {"send", &proto::FrameTiming::send}};
+
+}  // namespace
+
 bool progressOn(Tcl_Interp* interp) {
   const char* v = Tcl_GetVar2(interp, "::pvr::progress", nullptr, TCL_GLOBAL_ONLY);
   int on = 0;
@@ -19,11 +35,7 @@ bool progressOn(Tcl_Interp* interp) {
 Tcl_Obj* timingDict(const FrameRecord& r) {
   Tcl_Obj* d = Tcl_NewDictObj();
   const auto put = [&](const char* k, double v) { Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj(k, -1), Tcl_NewDoubleObj(v)); };
-  put("dist", r.timing.distribute);
-  put("rend", r.timing.render);
-  put("comp", r.timing.composite);
-  put("comm", r.timing.communicate);
-  put("send", r.timing.send);
+  for (const Phase& p : kPhases) put(p.name, r.timing.*p.value);
   put("arrival", r.arrival);
   Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj("width", -1), Tcl_NewIntObj(r.width));
   Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj("height", -1), Tcl_NewIntObj(r.height));
@@ -57,23 +69,24 @@ void Session::printTable(const Sequence& seq) const {
   std::fprintf(stderr, "%s %s: %zu frames in %.3f s (%.2f fps)%s\n", name_.c_str(), seq.label.c_str(),
                seq.frames.size(), total, total > 0 ? double(seq.frames.size()) / total : 0.0,
                seq.cancelled ? ", cancelled" : "");
-  std::fprintf(stderr, "%6s %9s %9s %9s %9s %9s %9s\n", "frame", "dist", "rend", "comp", "comm", "send", "arrival");
+  std::fprintf(stderr, "%6s", "frame");
+  for (const Phase& p : kPhases) std::fprintf(stderr, " %9s", p.name);
+  std::fprintf(stderr, " %9s\n", "arrival");
   proto::FrameTiming sum;
   for (const auto& r : seq.frames) {
-    std::fprintf(stderr, "%6u %9.4f %9.4f %9.4f %9.4f %9.4f %9.4f\n", r.frame, r.timing.distribute, r.timing.render,
-                 r.timing.composite, r.timing.communicate, r.timing.send, r.arrival);
-    sum.distribute += r.timing.distribute;
-    sum.render += r.timing.render;
-    sum.composite += r.timing.composite;
-    sum.communicate += r.timing.communicate;
-    sum.send += r.timing.send;
+    std::fprintf(stderr, "%6u", r.frame);
+    for (const Phase& p : kPhases) {
+      std::fprintf(stderr, " %9.4f", r.timing.*p.value);
+      sum.*p.value += r.timing.*p.value;
+    }
+    std::fprintf(stderr, " %9.4f\n", r.arrival);
   }
-  const double all = sum.distribute + sum.render + sum.composite + sum.communicate + sum.send;
-  const auto share = [&](double v) { return all > 0 ? 100.0 * v / all : 0.0; };
-  std::fprintf(stderr, "breakdown (s, share): dist %.3f (%.0f%%)  rend %.3f (%.0f%%)  comp %.3f (%.0f%%)  "
-                       "comm %.3f (%.0f%%)  send %.3f (%.0f%%)\n",
-               sum.distribute, share(sum.distribute), sum.render, share(sum.render), sum.composite,
-               share(sum.composite), sum.communicate, share(sum.communicate), sum.send, share(sum.send));
+  double all = 0;
+  for (const Phase& p : kPhases) all += sum.*p.value;
+  std::fprintf(stderr, "breakdown (s, share):");
+  for (const Phase& p : kPhases)
+    std::fprintf(stderr, " %s %.3f (%.0f%%)", p.name, sum.*p.value, all > 0 ? 100.0 * sum.*p.value / all : 0.0);
+  std::fputc('\n', stderr);
 }
 
 }  // namespace pvr::tcl
