@@ -26,6 +26,15 @@ if(TARGET pvr_comm_mpi AND TARGET pvr-node)
                          PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 60 PROCESSORS 2)
   endforeach()
 
+  # pvr-node --batch's report names every phase and each rank's peak RSS.
+  add_test(NAME "node mpi: pvr-node --batch reports every phase and each rank's memory"
+           COMMAND ${CMAKE_COMMAND}
+                   -DMPIRUN=${MPIEXEC_EXECUTABLE} -DPVR_NODE=$<TARGET_FILE:pvr-node>
+                   -DWORK=${PVR_MPI_SCRATCH}/batch-report
+                   -P ${CMAKE_CURRENT_SOURCE_DIR}/batch_report_test.cmake)
+  set_tests_properties("node mpi: pvr-node --batch reports every phase and each rank's memory"
+                       PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 60 PROCESSORS 2)
+
   # The programs themselves: pvr-node under mpirun against pvr-render, and a
   # bad scene failing on every rank with one message.
   if(TARGET pvr-render)
