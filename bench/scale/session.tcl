@@ -1,0 +1,111 @@
+# session.tcl -- one pvrsh session of bench/scale (run.sh starts pvrd and
+# drops the page cache before it): time to the first frame, its phases,
+# then the frame rate of the frames after it.
+#
+#   pvrsh -nogui session.tcl -host HOST:PORT -pvrd PID -dataset NAME -csv FILE
+#         ?-kind pvrsh? ?-cache cold|warm? ?-ranks 8? ?-size 512? ?-settings {-tf ... -shading 1 ...}?
+#         ?-frames 20? ?-readfile SECONDS? ?-voxels N?
+#         ?-series STEPS? ?-cachemem MB?
+#
+# Static (-series 0): `open`, `set -dataset ...`, `render frame` (the first
+# frame: the job reads and preprocesses its bricks), then `render rotate
+# 0,0,1 0,F-1:F` (F = -frames) at the same data.
+# Series (-series STEPS, the dataset's number of steps): the same first
+# frame (step 0), `set -cachemem MB` before it when -cachemem is given,
+# then `render time 1,STEPS-1` through the remaining steps, and
+# `performance cache` printed after it.
+# Appends one row to FILE in run.sh's columns (bench/scale/README.md):
+# wall_s is `open` to the first frame's arrival (pvrd's mpirun launch, the
+# job's start, the dataset load and the frame); start is `open` alone; the
+# phases are the first frame's (max over ranks, as the collector reports
+# them); fps is frames over the last frame's arrival; rss from VmHWM of
+# every pvr-node under pvrd PID, read before `close`, in pid order.
+set defaults {-host "" -pvrd 0 -dataset "" -csv "" -kind pvrsh -cache warm -ranks 8 -size 512 -settings ""
+              -frames 20 -readfile "" -voxels 0 -series 0 -cachemem ""}
+set unknown [lmap k [dict keys $argv] {expr {[dict exists $defaults $k] ? [continue] : $k}}]
+if {[llength $unknown]} {
+    puts stderr "session.tcl: unknown options $unknown (known: [dict keys $defaults])"
+    exit 2
+}
+array set opt [dict merge $defaults $argv]
+set ::pvr::progress 0
+set phases {read prep dist rend comp comm send}
+
+# pvrNodePeaks: the peak RSS (MB) of every pvr-node descending from pid
+# `root`, in pid order (ranks start in rank order).
+proc pvrNodePeaks {root} {
+    set parent [dict create]
+    set name [dict create]
+    foreach dir [glob -nocomplain -directory /proc {[0-9]*}] {
+        if {[catch {
+            set f [open $dir/stat]
+            set stat [read $f]
+            close $f
+        }]} continue
+        # The command name is in parentheses and may hold spaces.
+        set close [string last ")" $stat]
+        set pid [file tail $dir]
+        dict set name $pid [string range $stat [expr {[string first "(" $stat] + 1}] [expr {$close - 1}]]
+        dict set parent $pid [lindex [string range $stat [expr {$close + 2}] end] 1]
+    }
+    set peaks {}
+    foreach pid [lsort -integer [dict keys $name]] {
+        if {[dict get $name $pid] ne "pvr-node"} continue
+        for {set p $pid} {$p > 1 && $p != $root} {set p [dict get $parent $p]} {
+            if {![dict exists $parent $p]} break
+        }
+        if {$p != $root} continue
+        if {[catch {
+            set f [open /proc/$pid/status]
+            set status [read $f]
+            close $f
+        }]} continue
+        if {[regexp {VmHWM:\s+(\d+) kB} $status -> kb]} {
+            lappend peaks [format %.1f [expr {$kb / 1024.0}]]
+        }
+    }
+    return $peaks
+}
+
+set t0 [clock microseconds]
+pvr_session :s
+:s open $opt(-host) -ranks $opt(-ranks) -timeout 600
+set opened [clock microseconds]
+set settings [list -dataset $opt(-dataset) -imagesz $opt(-size),$opt(-size) {*}$opt(-settings)]
+if {$opt(-cachemem) ne ""} { lappend settings -cachemem $opt(-cachemem) }
+:s set {*}$settings
+:s render frame
+:s wait -timeout 3600
+set first [lindex [:s timing] 0]
+set firstAt [clock microseconds]
+
+# The frames after the first.
+if {$opt(-series)} {
+    :s render time 1,[expr {$opt(-series) - 1}]
+    set frames [expr {$opt(-series) - 1}]
+} else {
+    set frames $opt(-frames)
+    :s render rotate 0,0,1 0,[expr {$frames - 1}]:$frames
+}
+:s wait -timeout 3600
+set records [:s timing]
+set fps [expr {$frames / [dict get [lindex $records end] arrival]}]
+if {$opt(-series) && ![catch {:s performance cache} cache]} {
+    puts "$opt(-kind) cache after `render time`: $cache"
+}
+set peaks [pvrNodePeaks $opt(-pvrd)]
+:s close
+
+set wall [expr {($firstAt - $t0) * 1e-6}]
+set row [list $opt(-kind) $opt(-ranks) $opt(-cache) $opt(-voxels) [format %.4f $wall] $opt(-readfile) \
+             [format %.4f [expr {($opened - $t0) * 1e-6}]]]
+foreach p $phases { lappend row [format %.4f [dict get $first $p]] }
+lappend row "" $frames [format %.3f $fps]
+set rssMax [expr {[llength $peaks] ? [tcl::mathfunc::max {*}$peaks] : ""}]
+lappend row $rssMax [join $peaks " "]
+set f [open $opt(-csv) a]
+puts $f [join $row ,]
+close $f
+puts [format "%-15s %d ranks %-4s first frame %.3f s (open %.3f s; %s), then %d frames at %.2f fps; peak RSS MB %s" \
+      $opt(-kind) $opt(-ranks) $opt(-cache) $wall [expr {($opened - $t0) * 1e-6}] \
+      [join [lmap p $phases {format "%s %.3f" $p [dict get $first $p]}] " "] $frames $fps $peaks]
