@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
       writeVolume(head, (fs::path(dir) / stem).string(), name, n, shift,
                   describe(head, n) + "; series step " + std::to_string(k) + " of " + std::to_string(steps) +
                       ", moved along x");
-      series.push_back({{"time", 0.1 * k}, {"file", stem + "/" + name + ".json"}});
+      series.push_back({{"time", k / 10.0}, {"file", stem + "/" + name + ".json"}});
     }
     const std::string path = (fs::path(dir) / (stem + ".series.json")).string();
     std::ofstream(path) << nlohmann::json{{"series", series}}.dump(1) << "\n";
