@@ -4,6 +4,7 @@
 # every rank's peak RSS is at least the voxel bytes it holds (a rank that
 # reports less than its brick did not measure itself). Three ranks on a
 # procedural volume large enough (64^3 float) that its brick shows in RSS.
+cmake_minimum_required(VERSION 3.20)  # policies of this century in -P mode (CMP0012)
 file(MAKE_DIRECTORY ${WORK})
 file(WRITE ${WORK}/scene.json [=[
 {"volume": {"procedural": "shepp-logan", "dims": [64, 64, 64]},
@@ -46,22 +47,25 @@ foreach(column brick_bytes start read prep dist write wall peak_rss_bytes)
     message(FATAL_ERROR "report.csv has no column ${column}: ${header}")
   endif()
 endforeach()
-foreach(rank 0 1 2)
+# field(RANK COLUMN OUT): rank RANK's value in column COLUMN.
+function(field rank column out)
   math(EXPR line "${rank} + 1")
   list(GET lines ${line} row)
   string(REPLACE "," ";" row "${row}")
-  list(GET row ${index_brick_bytes} brick)
-  list(GET row ${index_peak_rss_bytes} rss)
+  list(GET row ${index_${column}} value)
+  set(${out} ${value} PARENT_SCOPE)
+endfunction()
+foreach(rank 0 1 2)
+  field(${rank} brick_bytes brick)
+  field(${rank} peak_rss_bytes rss)
   if(NOT brick GREATER 0 OR rss LESS brick)
     message(FATAL_ERROR "rank ${rank}: peak RSS ${rss} bytes below its ${brick} voxel bytes")
   endif()
 endforeach()
 # Rank 0's wall time is its process age when the image was written, taken
 # after its start (the age at the frame's start): both from the same clock.
-list(GET lines 1 row)
-string(REPLACE "," ";" row "${row}")
-list(GET row ${index_start} start)
-list(GET row ${index_wall} wall)
+field(0 start start)
+field(0 wall wall)
 if(NOT start GREATER 0 OR wall LESS start)
   message(FATAL_ERROR "rank 0: start ${start} s and wall ${wall} s out of order")
 endif()
