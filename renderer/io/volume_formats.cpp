@@ -9,6 +9,7 @@ namespace pvr::core {
 const std::vector<VolumeFormat>& volumeFormats() {
   // One line per format: a new format is one new file plus one line here.
   static const std::vector<VolumeFormat> kFormats = {
+      {"series", &isSeriesPath, &openSeries, ".series.json"},
       {"raw+json", &isRawJsonPath, &openRawJson, ".json .raw"},
       {"nrrd", &isNrrdPath, &openNrrd, ".nrrd .nhdr"},
       {"nifti", &isNiftiPath, &openNifti, ".nii .nii.gz"},
