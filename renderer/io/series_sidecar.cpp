@@ -69,7 +69,11 @@ std::unique_ptr<VolumeSource> openSeries(const std::string& path) {
   steps.reserve(named.size());
   for (std::size_t k = 0; k < named.size(); ++k) {
     const std::string file = stepFilePath(path, named[k].file, path, std::int64_t(k));
-    auto volume = openStep(path, std::int64_t(k), named[k].file, file, [&] { return openVolumeFile(file); });
+    auto volume = openStep(path, std::int64_t(k), named[k].file, file, [&] {
+      // Refused by name: a sidecar naming itself would never return.
+      if (isSeriesPath(file)) failAt(ErrorCode::kBadFile, file, "is itself a series sidecar; a step is one volume");
+      return openVolumeFile(file);
+    });
     steps.push_back({named[k].time, std::move(volume), named[k].file, file});
   }
   return makeSeries(path, fileNameOf(path), std::move(steps));
