@@ -17,6 +17,9 @@ std::unique_ptr<VolumeSource> openSeries(const std::string& path);
 // raw_json.cpp: a raw voxel file plus its JSON sidecar (dims, dtype, spacing, ...).
 bool isRawJsonPath(const std::string& path);
 std::unique_ptr<VolumeSource> openRawJson(const std::string& path);
+// A .raw opens through the sidecar beside it: a second name for that
+// sidecar's dataset, not a dataset of its own.
+bool isRawJsonDataPath(const std::string& path);
 
 // nrrd.cpp: NRRD with an attached (.nrrd) or detached (.nhdr) header.
 bool isNrrdPath(const std::string& path);

@@ -121,9 +121,11 @@ bool isRawJsonPath(const std::string& path) {
   return pathEndsWith(path, ".json") || pathEndsWith(path, ".raw");
 }
 
+bool isRawJsonDataPath(const std::string& path) { return pathEndsWith(path, ".raw"); }
+
 std::unique_ptr<VolumeSource> openRawJson(const std::string& path) {
   // Step: find the sidecar (the path itself, or <stem>.json beside a .raw).
-  const bool givenRaw = pathEndsWith(path, ".raw");
+  const bool givenRaw = isRawJsonDataPath(path);
   const std::string jsonPath = givenRaw ? fs::path(path).replace_extension(".json").string() : path;
   if (givenRaw && !fs::exists(jsonPath))
     failAt(ErrorCode::kIo, path, "no JSON sidecar " + jsonPath + " beside it (dims, dtype, spacing)");

@@ -93,9 +93,13 @@ std::vector<std::unique_ptr<VolumeSource>> openPackedSteps(const std::string& na
                                                            ScalarType type, const RawLayout& layout,
                                                            std::int64_t count, SizeRule rule);
 
-// The files a series reads its steps from (for a catalog, which lists the
-// series and not its step files); empty for a single volume or a series
-// whose steps live in one file.
+// For catalogs, which list each dataset once: a series, not its step files.
+//
+// isDatasetFileName: whether a registered format opens `name` as a dataset
+// of its own (volume_formats.cpp; a .raw is its sidecar's data, not one).
+// seriesFiles: the files a series reads its steps from; empty for a single
+// volume or a series whose steps live in one file.
+bool isDatasetFileName(const std::string& name);
 std::vector<std::string> seriesFiles(const VolumeSource& source);
 
 }  // namespace pvr::core

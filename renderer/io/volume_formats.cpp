@@ -2,6 +2,7 @@
 #include <filesystem>
 
 #include "formats.h"
+#include "series.h"
 #include "source_util.h"
 
 namespace pvr::core {
@@ -15,6 +16,13 @@ const std::vector<VolumeFormat>& volumeFormats() {
       {"nifti", &isNiftiPath, &openNifti, ".nii .nii.gz"},
   };
   return kFormats;
+}
+
+bool isDatasetFileName(const std::string& name) {
+  if (isRawJsonDataPath(name)) return false;
+  for (const VolumeFormat& format : volumeFormats())
+    if (format.matches(name)) return true;
+  return false;
 }
 
 std::unique_ptr<VolumeSource> openVolumeFile(const std::string& path) {
