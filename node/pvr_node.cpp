@@ -10,6 +10,11 @@
 //          [--early-termination A] [--threads N] [--codec auto|rle|rle-zlib|raw]
 //          [--size WxH] [--stats FILE.csv]
 //
+// Catalog mode lists the datasets of a data directory for pvrd, without
+// MPI (catalog_listing.h):
+//
+//   pvr-node --catalog DIR
+//
 // (the usage text lists the registered strategies and decompositions).
 // Every rank reads its own brick (or rank 0 scatters when the format cannot
 // read part of a file), renders it, and the ranks composite; rank 0 writes
@@ -23,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "catalog_listing.h"
 #include "frame.h"
 #include "hosts.h"
 #include "image_io.h"
@@ -53,7 +59,8 @@ std::string usage() {
          "       mpirun -np N pvr-node --batch SCENE.json -o OUT.exr|OUT.png\n"
          "       [--strategy " + names(composite::strategies(), "|") + "] [--radix K]\n"
          "       [--decomposition " + names(node::decompositions(), "|") + "] [--early-termination A]\n"
-         "       [--threads N] [--codec auto|rle|rle-zlib|raw] [--size WxH] [--stats FILE.csv]\n";
+         "       [--threads N] [--codec auto|rle|rle-zlib|raw] [--size WxH] [--stats FILE.csv]\n"
+         "       pvr-node --catalog DIR\n";
 }
 
 [[noreturn]] void bad(const std::string& why) { throw Error(ErrorCode::kInvalidArgument, why); }
@@ -153,6 +160,7 @@ int run(const Args& args, const std::vector<std::string>& hosts, comm::Communica
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "--catalog") return node::printCatalog(argv[2], stdout, stderr);
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) != "--server") continue;
     node::ServerOptions options;

@@ -1,18 +1,24 @@
 #include "catalog.h"
 
+#include <poll.h>
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cctype>
 #include <climits>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+
+#include "job_process.h"
+#include "sys.h"
 
 namespace pvr::daemon {
 namespace {
 
 namespace fs = std::filesystem;
-
-bool endsWith(const std::string& s, const std::string& tail) {
-  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
-}
+using proto::ErrorCode;
 
 std::string realPath(const std::string& path) {
   char buf[PATH_MAX];
@@ -24,43 +30,74 @@ bool inside(const std::string& root, const std::string& path) {
          (root == "/" || path[root.size()] == '/');
 }
 
-}  // namespace
-
-bool isVolumeFileName(const std::string& name) {
-  for (const char* ext : {".json", ".nhdr", ".nrrd", ".nii", ".nii.gz"})
-    if (endsWith(name, ext) && name.size() > std::char_traits<char>::length(ext)) return true;
-  return false;
+// "STEPS<TAB>NAME" with STEPS a positive 32-bit count, as node/catalog_listing.cpp prints it.
+bool parseEntry(const std::string& line, proto::CatalogEntry& entry) {
+  const std::size_t tab = line.find('\t');
+  if (tab == 0 || tab == std::string::npos || tab > 10 || tab + 1 == line.size()) return false;
+  std::uint64_t steps = 0;
+  for (std::size_t i = 0; i < tab; ++i) {
+    if (line[i] < '0' || line[i] > '9') return false;
+    steps = steps * 10 + std::uint64_t(line[i] - '0');
+  }
+  if (steps == 0 || steps > UINT32_MAX) return false;
+  entry = {line.substr(tab + 1), std::uint32_t(steps)};
+  return true;
 }
 
-std::vector<std::string> listDatasets(const std::string& dataDir) {
-  std::vector<std::string> names;
-  const std::string root = realPath(dataDir);
-  if (root.empty()) return names;
-  std::error_code ec;
-  auto consider = [&](const fs::path& file, const std::string& name) {
-    if (!isVolumeFileName(name)) return;
-    const std::string real = realPath(file.string());
-    if (inside(root, real) && fs::is_regular_file(real, ec)) names.push_back(name);
+}  // namespace
+
+std::variant<std::vector<proto::CatalogEntry>, proto::ProtocolError> listDatasets(
+    const std::string& nodePath, const std::string& dataDir, double timeoutSeconds,
+    const std::function<void(const std::string&)>& note) {
+  const std::string command = nodePath + " --catalog " + dataDir;
+  const auto failed = [&](ErrorCode code, const std::string& why) {
+    return proto::ProtocolError{code, "cannot list the catalog: " + command + ": " + why};
   };
-  for (const auto& entry : fs::directory_iterator(root, ec)) {
-    const std::string top = entry.path().filename().string();
-    if (top.empty() || top[0] == '.') continue;
-    if (entry.is_directory(ec)) {
-      if (!inside(root, realPath(entry.path().string()))) continue;
-      for (const auto& sub : fs::directory_iterator(entry.path(), ec)) {
-        const std::string leaf = sub.path().filename().string();
-        if (!leaf.empty() && leaf[0] != '.') consider(sub.path(), top + "/" + leaf);
+  JobProcess program;
+  std::string error;
+  if (!program.start({nodePath, "--catalog", dataDir}, {}, SIGKILL, error)) return failed(ErrorCode::kIo, error);
+
+  // Step: read its lines until its output ends, within the time limit.
+  const double deadline = monotonicSeconds() + timeoutSeconds;
+  std::vector<proto::CatalogEntry> entries;
+  std::string lastNote, malformed;
+  while (program.outputFd() >= 0 || !program.reap()) {
+    const double left = deadline - monotonicSeconds();
+    if (left <= 0) {
+      program.stop();
+      char limit[32];
+      std::snprintf(limit, sizeof limit, "%g", timeoutSeconds);
+      return failed(ErrorCode::kTimeout, std::string("did not finish in ") + limit + " s");
+    }
+    if (program.outputFd() < 0) {  // output closed: waiting for the exit
+      ::usleep(5000);
+      continue;
+    }
+    pollfd fd{program.outputFd(), POLLIN, 0};
+    ::poll(&fd, 1, std::max(1, int(left * 1000)));
+    for (std::string& line : program.readLines()) {
+      proto::CatalogEntry entry;
+      if (parseEntry(line, entry)) {
+        entries.push_back(std::move(entry));
+      } else if (!line.empty() && std::isdigit(static_cast<unsigned char>(line[0]))) {
+        malformed = line;
+      } else if (!line.empty()) {
+        note(line);
+        lastNote = line;
       }
-    } else {
-      consider(entry.path(), top);
     }
   }
-  std::sort(names.begin(), names.end());
-  return names;
+
+  // Step: only a clean exit is a catalog.
+  if (program.exitText() != "exited with status 0")
+    return failed(ErrorCode::kIo, program.exitText() + (lastNote.empty() ? "" : ": " + lastNote));
+  if (!malformed.empty())
+    return failed(ErrorCode::kIo, "malformed line '" + printable({reinterpret_cast<const std::uint8_t*>(malformed.data()),
+                                                                  malformed.size()}, 80) + "'");
+  return entries;
 }
 
 std::variant<std::string, proto::ProtocolError> resolveDataset(const std::string& dataDir, const std::string& name) {
-  using proto::ErrorCode;
   if (name.empty() || name[0] == '/' || name.find('\0') != std::string::npos)
     return proto::ProtocolError{ErrorCode::kBadArgument, "dataset names are relative to the data directory"};
   for (const auto& part : fs::path(name))
@@ -68,7 +105,7 @@ std::variant<std::string, proto::ProtocolError> resolveDataset(const std::string
   const std::string root = realPath(dataDir);
   const std::string real = realPath(root + "/" + name);
   std::error_code ec;
-  if (root.empty() || !inside(root, real) || !isVolumeFileName(name) || !fs::is_regular_file(real, ec))
+  if (root.empty() || !inside(root, real) || !fs::is_regular_file(real, ec))
     return proto::ProtocolError{ErrorCode::kDatasetNotFound, "no dataset '" + name + "' in the catalog"};
   return real;
 }

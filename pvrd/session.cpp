@@ -147,9 +147,15 @@ void Session::onClient(proto::Decoded frame) {
   if (std::holds_alternative<proto::JobHello>(m))
     return replyError(ErrorCode::kUnexpectedMessage, "JobHello is the rendering job's message, not a client's", id);
   if (std::holds_alternative<proto::CatalogRequest>(m)) {
-    proto::CatalogReply reply;
-    for (auto& name : listDatasets(opt_.dataDir)) reply.datasets.push_back({std::move(name), 1});
-    sendClient(reply, id);
+    // The node program knows the formats (catalog.h); a failure is the
+    // client's Error and this session serves on.
+    auto listed = listDatasets(cfg_.nodePath, opt_.dataDir, kCatalogSeconds,
+                               [this](const std::string& note) { log("catalog: " + note); });
+    if (const auto* err = std::get_if<proto::ProtocolError>(&listed)) {
+      log(err->text);
+      return replyError(err->code, err->text, id);
+    }
+    sendClient(proto::CatalogReply{std::move(std::get<std::vector<proto::CatalogEntry>>(listed))}, id);
     return;
   }
   if (const auto* open = std::get_if<proto::SessionOpen>(&m)) return openSession(*open, id);

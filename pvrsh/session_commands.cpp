@@ -163,26 +163,34 @@ int imageCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   return TCL_OK;
 }
 
-// :s list status | :s list datasets
+// :s list status | :s list datasets ?-steps?
+// Datasets: the catalog's names; with -steps a dictionary of name -> number
+// of time steps (1 for a single volume), in catalog order.
 int listCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   static const char* const kWhat[] = {"datasets", "status", nullptr};
-  if (objc != 3) {
-    Tcl_WrongNumArgs(interp, 2, objv, "status|datasets");
+  if (objc != 3 && objc != 4) {
+    Tcl_WrongNumArgs(interp, 2, objv, "status|datasets ?-steps?");
     return TCL_ERROR;
   }
   int what = 0;
   if (Tcl_GetIndexFromObj(interp, objv[2], kWhat, "list", 0, &what) != TCL_OK)
     throw TclError({"PVR", "ARGS", "LIST"}, Tcl_GetStringResult(interp));
+  if (objc == 4 && (what == 1 || str(objv[3]) != "-steps"))
+    argsError("LIST", "bad option \"" + str(objv[3]) + "\": " +
+                          (what == 1 ? "list status takes no option" : "list datasets takes only -steps"));
   if (what == 1) {
     Tcl_SetObjResult(interp, s.statusObj());
     return TCL_OK;
   }
   s.requireOpen("list datasets");
+  const bool withSteps = objc == 4;
   Tcl_Obj* list = Tcl_NewListObj(0, nullptr);
   for (const auto& m : s.query(proto::CatalogRequest{}, 30))
     if (const auto* c = std::get_if<proto::CatalogReply>(&m))
-      for (const auto& entry : c->datasets)
+      for (const auto& entry : c->datasets) {
         Tcl_ListObjAppendElement(nullptr, list, Tcl_NewStringObj(entry.name.c_str(), -1));
+        if (withSteps) Tcl_ListObjAppendElement(nullptr, list, Tcl_NewWideIntObj(Tcl_WideInt(entry.steps)));
+      }
   Tcl_SetObjResult(interp, list);
   return TCL_OK;
 }

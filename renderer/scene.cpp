@@ -13,11 +13,12 @@ namespace pvr::core {
 using namespace scene_json;
 
 Scene parseScene(const json& doc, const std::string& baseDir) {
-  requireObject(doc, "", {"volume", "transfer_function", "camera", "image", "sampling", "shading"});
+  requireObject(doc, "", {"volume", "timestep", "transfer_function", "camera", "image", "sampling", "shading"});
   Scene scene;
   const json* volume = find(doc, "volume");
   if (!volume) fail("volume", "missing (every scene names its volume)");
   scene.volume = parseVolume(*volume, baseDir);
+  if (const json* v = find(doc, "timestep")) scene.volume.timestep = parseTimestep(*v);
   const json* tf = find(doc, "transfer_function");
   scene.transfer = tf ? parseTransfer(*tf, baseDir) : defaultTransfer();
   if (const json* v = find(doc, "camera")) scene.camera = parseCameraSection(*v);
@@ -40,6 +41,7 @@ Scene loadSceneFile(const std::string& path) {
 
 json sceneToJson(const Scene& s) {
   json doc = {{"volume", volumeToJson(s.volume)},
+              {"timestep", s.volume.timestep},
               {"transfer_function", transferToJson(s.transfer)},
               {"image", imageToJson(s.image)},
               {"sampling", samplingToJson(s.sampling)},

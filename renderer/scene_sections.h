@@ -18,6 +18,11 @@ namespace pvr::core {
 VolumeSpec parseVolume(const nlohmann::json& section, const std::string& baseDir);
 nlohmann::json volumeToJson(const VolumeSpec& volume);
 
+// "timestep": a 0-based step of a time series, 0..INT32_MAX. Whether the
+// volume has that step is checkTimestep's to say (scene_volume.h), once the
+// volume is open.
+int parseTimestep(const nlohmann::json& value);
+
 // "transfer_function": points, a ParaView preset file (relative to baseDir)
 // or an inline preset; defaultTransfer() is the scene without the section.
 TransferFunctionSpec parseTransfer(const nlohmann::json& section, const std::string& baseDir);

@@ -1,4 +1,5 @@
-// The volume a scene names, opened from a file or generated.
+// The volume a scene names, opened from a file or generated, and the check
+// that the scene's timestep is one of its steps.
 #pragma once
 
 #include <memory>
@@ -8,6 +9,14 @@
 
 namespace pvr::core {
 
+// Opens the volume and checks spec.timestep against it (checkTimestep).
+// Throws pvr::Error naming the file or procedural volume.
 std::unique_ptr<VolumeSource> openSceneVolume(const VolumeSpec& spec);
+
+// Throws pvr::Error(kInvalidArgument) unless 0 <= spec.timestep <
+// source.steps(): "timestep 7: run.series.json has 5 time steps (0..4)".
+// A caller that keeps the source open and changes only the timestep calls
+// this itself.
+void checkTimestep(const VolumeSpec& spec, const VolumeSource& source);
 
 }  // namespace pvr::core

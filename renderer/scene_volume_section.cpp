@@ -1,4 +1,5 @@
-// The scene's "volume" section: a volume file or a procedural volume.
+// The scene's "volume" section: a volume file or a procedural volume; and
+// the top-level "timestep", the step of a time-series volume to render.
 #include <algorithm>
 
 #include "io/volume_io.h"
@@ -47,6 +48,13 @@ VolumeSpec parseVolume(const json& v, const std::string& baseDir) {
     spec.spacing = s;
   }
   return spec;
+}
+
+int parseTimestep(const json& v) {
+  const std::int64_t k = asInteger(v, "timestep");
+  if (k < 0 || k > INT32_MAX)
+    fail("timestep", "must be in 0.." + std::to_string(INT32_MAX) + " (a 0-based step), got " + std::to_string(k));
+  return int(k);
 }
 
 json volumeToJson(const VolumeSpec& volume) {

@@ -13,6 +13,10 @@
 // applied. A scl_slope other than 0 or 1 (or a nonzero scl_inter) makes the
 // volume float32 with the scaling applied, since the stored integers are
 // not the values the file means.
+//
+// A 4-D file (dim[0] = 4, dim[4] = T > 1) is a time series (series.h): step
+// k is the k-th 3-D volume, at time toffset + k * pixdim[4] (in the file's
+// time units), or at time k when pixdim[4] is not positive.
 #include <nifti/nifti1_io.h>
 
 #include <algorithm>
@@ -23,6 +27,7 @@
 #include "formats.h"
 #include "gzip_stream.h"
 #include "raw_reader.h"
+#include "series.h"
 #include "source_util.h"
 
 namespace pvr::core {
@@ -77,11 +82,11 @@ ScalarType niftiScalarType(const nifti_image& nim, const std::string& path) {
 }
 
 GridGeometry niftiGrid(const nifti_image& nim, const std::string& path) {
-  for (int d = 4; d <= 7; ++d)
+  for (int d = 5; d <= 7; ++d)
     if (nim.dim[d] > 1)
       failAt(ErrorCode::kUnsupported, path,
              "dimension " + std::to_string(d) + " has " + std::to_string(nim.dim[d]) +
-                 " entries; only 3D volumes are supported");
+                 " entries; only 3D volumes and 4D time series are supported");
   GridGeometry grid;
   grid.dims = {std::max(nim.nx, 1), std::max(nim.ny, 1), std::max(nim.nz, 1)};
   grid.spacing = {std::fabs(nim.dx), std::fabs(nim.dy), std::fabs(nim.dz)};
@@ -147,12 +152,24 @@ std::unique_ptr<VolumeSource> openNifti(const std::string& path) {
   layout.encoding = gzip ? RawEncoding::kGzip : RawEncoding::kRaw;
   layout.offset = std::uint64_t(std::max(nim->iname_offset, 0));
   layout.bigEndian = nim->byteorder == kNiftiMsbFirst;
-  auto source = openRawVolume(fileNameOf(path), grid, type, std::move(layout), SizeRule::kAtLeast);
-
   const double slope = nim->scl_slope, inter = nim->scl_inter;
-  if (std::isfinite(slope) && std::isfinite(inter) && slope != 0 && (slope != 1 || inter != 0))
-    return std::make_unique<ScaledSource>(std::move(source), slope, inter);
-  return source;
+  const bool scaled = std::isfinite(slope) && std::isfinite(inter) && slope != 0 && (slope != 1 || inter != 0);
+  const auto applyScaling = [&](std::unique_ptr<VolumeSource> stored) -> std::unique_ptr<VolumeSource> {
+    if (!scaled) return stored;
+    return std::make_unique<ScaledSource>(std::move(stored), slope, inter);
+  };
+  const std::int64_t timeSteps = nim->dim[0] >= 4 ? std::max<std::int64_t>(nim->dim[4], 1) : 1;
+  if (timeSteps == 1)
+    return applyScaling(openRawVolume(fileNameOf(path), grid, type, std::move(layout), SizeRule::kAtLeast));
+
+  // Step 4: a time series, the 3-D volumes one after another.
+  const double dt = std::isfinite(nim->dt) && nim->dt > 0 ? nim->dt : 1.0;
+  const double t0 = nim->dt > 0 && std::isfinite(nim->toffset) ? nim->toffset : 0.0;
+  std::vector<SeriesStep> steps;
+  for (auto& step : openPackedSteps(fileNameOf(path), grid, type, layout, timeSteps, SizeRule::kAtLeast))
+    steps.push_back({t0 + double(steps.size()) * dt, applyScaling(std::move(step)),
+                     "volume " + std::to_string(steps.size()), ""});
+  return makeSeries(path, fileNameOf(path), std::move(steps));
 }
 
 }  // namespace pvr::core

@@ -2,6 +2,9 @@
 //   {"dims": [nx, ny, nz], "dtype": "int16", "spacing": [sx, sy, sz],
 //    "origin": [ox, oy, oz]            (optional, default 0),
 //    "raw_file": "<name>.raw"          (optional, default: the .raw beside the sidecar),
+//    "pattern": "step_%04d.raw", "steps": N, ...
+//                                      (instead of raw_file: a time series, one raw
+//                                       file per step, keys of series.h patternSteps),
 //    "endian": "little" | "big"        (optional, default little), ...}
 // Other keys (provenance, licence, statistics) are ignored. Either file may
 // be given: a .raw finds its sidecar beside it, <stem>.json. The writer of
@@ -13,6 +16,7 @@
 #include "formats.h"
 #include "json_file.h"
 #include "raw_reader.h"
+#include "series.h"
 #include "source_util.h"
 
 namespace pvr::core {
@@ -88,15 +92,40 @@ std::string rawPathFor(const json& doc, const std::string& jsonPath, const std::
   return named.string();
 }
 
+// A sidecar with "pattern": step k's voxels are the whole raw file the
+// pattern names for it; the sidecar's grid, type and byte order apply to
+// every step.
+std::unique_ptr<VolumeSource> openRawSeries(const json& doc, const std::string& jsonPath, const std::string& givenRaw,
+                                            const GridGeometry& grid, ScalarType type, const RawLayout& layout) {
+  if (!givenRaw.empty())
+    failAt(ErrorCode::kBadFile, givenRaw,
+           "sidecar " + jsonPath + " describes a time series ('pattern'); open the sidecar, not a step's raw file");
+  if (doc.contains("raw_file")) failAt(ErrorCode::kBadFile, jsonPath, "give 'raw_file' or 'pattern', not both");
+  std::vector<SeriesStep> steps;
+  for (const PatternStep& named : patternSteps(doc, jsonPath)) {
+    const std::int64_t k = std::int64_t(steps.size());
+    RawLayout step = layout;
+    step.dataPath = stepFilePath(jsonPath, named.file, jsonPath, k);
+    step.headerPath.clear();  // the step's label names the sidecar already
+    auto volume = openStep(jsonPath, k, named.file, step.dataPath, [&] {
+      return openRawVolume(fileNameOf(step.dataPath), grid, type, step, SizeRule::kExact);
+    });
+    steps.push_back({named.time, std::move(volume), named.file, step.dataPath});
+  }
+  return makeSeries(jsonPath, fileNameOf(jsonPath), std::move(steps));
+}
+
 }  // namespace
 
 bool isRawJsonPath(const std::string& path) {
   return pathEndsWith(path, ".json") || pathEndsWith(path, ".raw");
 }
 
+bool isRawJsonDataPath(const std::string& path) { return pathEndsWith(path, ".raw"); }
+
 std::unique_ptr<VolumeSource> openRawJson(const std::string& path) {
   // Step: find the sidecar (the path itself, or <stem>.json beside a .raw).
-  const bool givenRaw = pathEndsWith(path, ".raw");
+  const bool givenRaw = isRawJsonDataPath(path);
   const std::string jsonPath = givenRaw ? fs::path(path).replace_extension(".json").string() : path;
   if (givenRaw && !fs::exists(jsonPath))
     failAt(ErrorCode::kIo, path, "no JSON sidecar " + jsonPath + " beside it (dims, dtype, spacing)");
@@ -110,9 +139,10 @@ std::unique_ptr<VolumeSource> openRawJson(const std::string& path) {
   const ScalarType type = parseScalarType(readString(member(doc, "dtype", jsonPath), "dtype", jsonPath), jsonPath);
 
   RawLayout layout;
-  layout.dataPath = rawPathFor(doc, jsonPath, givenRaw ? path : std::string());
   layout.headerPath = jsonPath;
   layout.bigEndian = readBigEndian(doc, jsonPath);
+  if (doc.contains("pattern")) return openRawSeries(doc, jsonPath, givenRaw ? path : std::string(), grid, type, layout);
+  layout.dataPath = rawPathFor(doc, jsonPath, givenRaw ? path : std::string());
   return openRawVolume(fileNameOf(path), grid, type, std::move(layout), SizeRule::kExact);
 }
 

@@ -2,6 +2,7 @@
 #include <filesystem>
 
 #include "formats.h"
+#include "series.h"
 #include "source_util.h"
 
 namespace pvr::core {
@@ -9,11 +10,19 @@ namespace pvr::core {
 const std::vector<VolumeFormat>& volumeFormats() {
   // One line per format: a new format is one new file plus one line here.
   static const std::vector<VolumeFormat> kFormats = {
+      {"series", &isSeriesPath, &openSeries, ".series.json"},
       {"raw+json", &isRawJsonPath, &openRawJson, ".json .raw"},
       {"nrrd", &isNrrdPath, &openNrrd, ".nrrd .nhdr"},
       {"nifti", &isNiftiPath, &openNifti, ".nii .nii.gz"},
   };
   return kFormats;
+}
+
+bool isDatasetFileName(const std::string& name) {
+  if (isRawJsonDataPath(name)) return false;
+  for (const VolumeFormat& format : volumeFormats())
+    if (format.matches(name)) return true;
+  return false;
 }
 
 std::unique_ptr<VolumeSource> openVolumeFile(const std::string& path) {

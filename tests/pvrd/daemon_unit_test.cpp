@@ -1,4 +1,4 @@
-// The pure parts of pvrd: dataset names, HMAC, options, the advertised
+// The pure parts of pvrd: the catalog (with stand-in node programs), dataset names, HMAC, options, the advertised
 // address, mpirun messages.
 #include <catch2/catch.hpp>
 
@@ -47,9 +47,81 @@ ErrorCode codeOf(const std::variant<std::string, pvr::proto::ProtocolError>& r) 
 
 }  // namespace
 
-TEST_CASE("catalog lists volume files one level deep, names relative, symlinks out left out") {
-  const fs::path dir = makeDataDir();
-  CHECK(listDatasets(dir.string()) == std::vector<std::string>{"a.json", "b.nhdr", "sub/sub.nii.gz"});
+namespace {
+
+// A stand-in for `pvr-node --catalog DIR`: a shell script in the test's
+// scratch directory (the real program is run by the process tests).
+std::string fakeNode(const std::string& name, const std::string& body) {
+  const fs::path dir = fs::path(PVR_TEST_TMP) / ("fake_node_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path path = dir / name;
+  std::ofstream(path) << "#!/bin/sh\n" << body << "\n";
+  fs::permissions(path, fs::perms::owner_all);
+  return path.string();
+}
+
+using Listed = std::variant<std::vector<pvr::proto::CatalogEntry>, pvr::proto::ProtocolError>;
+
+pvr::proto::ProtocolError errorOf(const Listed& r) {
+  REQUIRE(std::holds_alternative<pvr::proto::ProtocolError>(r));
+  return std::get<pvr::proto::ProtocolError>(r);
+}
+
+// The process whose pid `pidFile` holds is gone or a zombie (dead, waiting
+// for whichever process adopted it to reap it).
+bool processGone(const fs::path& pidFile) {
+  std::ifstream in(pidFile);
+  pid_t pid = 0;
+  in >> pid;
+  REQUIRE(pid > 0);
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  const std::string s((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  const auto close = s.rfind(')');
+  return s.empty() || (close != std::string::npos && s.size() > close + 2 && s[close + 2] == 'Z');
+}
+
+}  // namespace
+
+TEST_CASE("the catalog is the node program's STEPS<TAB>NAME lines, its other lines are notes") {
+  std::vector<std::string> notes;
+  const auto listed = listDatasets(
+      fakeNode("lists", "echo 'pvr-node --catalog: left out bad.json: not JSON' >&2\n"
+                        "printf '1\\tball/ball.json\\n50\\truns/run.series.json\\n'\n"
+                        "test \"$1 $2\" = \"--catalog /the/dir\" || echo 'wrong arguments' >&2"),
+      "/the/dir", 10, [&](const std::string& n) { notes.push_back(n); });
+  REQUIRE(std::holds_alternative<std::vector<pvr::proto::CatalogEntry>>(listed));
+  CHECK(std::get<0>(listed) ==
+        std::vector<pvr::proto::CatalogEntry>{{"ball/ball.json", 1}, {"runs/run.series.json", 50}});
+  CHECK(notes == std::vector<std::string>{"pvr-node --catalog: left out bad.json: not JSON"});
+}
+
+TEST_CASE("a catalog program that fails, is missing or prints nonsense gives an error naming it") {
+  const auto ignore = [](const std::string&) {};
+  const auto failing = errorOf(listDatasets(fakeNode("fails", "echo 'pvr-node --catalog: /d: no such directory' >&2\nexit 3"),
+                                            "/d", 10, ignore));
+  CHECK(failing.code == ErrorCode::kIo);
+  CHECK_THAT(failing.text, Catch::Contains("cannot list the catalog") && Catch::Contains("fails --catalog /d") &&
+                               Catch::Contains("exited with status 3: pvr-node --catalog: /d: no such directory"));
+
+  const auto missing = errorOf(listDatasets("/nonexistent/pvr-node", "/d", 10, ignore));
+  CHECK(missing.code == ErrorCode::kIo);
+  CHECK_THAT(missing.text, Catch::Contains("/nonexistent/pvr-node --catalog /d") && Catch::Contains("status 127"));
+
+  const auto garbled = errorOf(listDatasets(fakeNode("garbled", "printf '12x\\tname\\n'"), "/d", 10, ignore));
+  CHECK_THAT(garbled.text, Catch::Contains("malformed line '12x\\x09name'"));
+  const auto zero = errorOf(listDatasets(fakeNode("zero", "printf '0\\tname\\n'"), "/d", 10, ignore));
+  CHECK_THAT(zero.text, Catch::Contains("malformed line"));
+}
+
+TEST_CASE("a catalog program over its time limit is killed with its children and reported") {
+  const fs::path pids = fs::path(PVR_TEST_TMP) / ("slow_catalog_" + std::to_string(::getpid()));
+  const auto slow = errorOf(listDatasets(
+      fakeNode("slow", "echo $$ > " + pids.string() + ".sh\nsleep 60 &\necho $! > " + pids.string() + ".sleep\nwait"),
+      "/d", 0.5, [](const std::string&) {}));
+  CHECK(slow.code == ErrorCode::kTimeout);
+  CHECK_THAT(slow.text, Catch::Contains("did not finish in 0.5 s"));
+  CHECK(processGone(pids.string() + ".sh"));
+  CHECK(processGone(pids.string() + ".sleep"));
 }
 
 TEST_CASE("dataset names resolve inside the data directory only") {
@@ -63,7 +135,9 @@ TEST_CASE("dataset names resolve inside the data directory only") {
   CHECK(codeOf(resolveDataset(dir.string(), "link.json")) == ErrorCode::kDatasetNotFound);
   CHECK(codeOf(resolveDataset(dir.string(), "linkdir/secret.json")) == ErrorCode::kDatasetNotFound);
   CHECK(codeOf(resolveDataset(dir.string(), "missing.json")) == ErrorCode::kDatasetNotFound);
-  CHECK(codeOf(resolveDataset(dir.string(), "notes.txt")) == ErrorCode::kDatasetNotFound);
+  CHECK(codeOf(resolveDataset(dir.string(), "sub")) == ErrorCode::kDatasetNotFound);  // a directory
+  // Whether a file is a volume is the node's to say when it opens it.
+  CHECK(std::holds_alternative<std::string>(resolveDataset(dir.string(), "notes.txt")));
   CHECK(codeOf(resolveDataset(dir.string(), "")) == ErrorCode::kBadArgument);
 }
 

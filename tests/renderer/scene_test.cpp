@@ -186,7 +186,7 @@ TEST_CASE("relative paths resolve against the base directory", "[scene]") {
 TEST_CASE("unknown keys are errors naming the key path and the known keys", "[scene]") {
   struct Case { const char* pointer; const char* message; };
   const Case cases[] = {
-      {"/fov", "fov: unknown key (known: volume, transfer_function, camera, image, sampling, shading)"},
+      {"/fov", "fov: unknown key (known: volume, timestep, transfer_function, camera, image, sampling, shading)"},
       {"/camera/fov", "camera.fov: unknown key (known: projection, eye, look_at, up, height, fov_y_deg)"},
       {"/volume/dim", "volume.dim: unknown key (known: file, procedural, dims, spacing)"},
       {"/transfer_function/point", "transfer_function.point: unknown key (known: points, paraview_preset, paraview, unit_distance)"},

@@ -242,11 +242,12 @@ TEST_CASE("unreadable or garbled headers are refused with the reason", "[io]") {
     std::memcpy(h.magic, "xyz", 4);
     writeBytes(dir + "/magic.nii", niftiBytes(h, v, false));
     REQUIRE_THROWS_WITH(openAndRead(dir + "/magic.nii"), Contains("no NIfTI-1 magic"));
+    // 4-D is a time series (volume_series_test.cpp); 5-D is refused.
     h = niftiHeader(v, {});
-    h.dim[0] = 4;
-    h.dim[4] = 3;
-    writeBytes(dir + "/4d.nii", niftiBytes(h, v, false));
-    REQUIRE_THROWS_WITH(openAndRead(dir + "/4d.nii"), Contains("only 3D volumes"));
+    h.dim[0] = 5;
+    h.dim[5] = 3;
+    writeBytes(dir + "/5d.nii", niftiBytes(h, v, false));
+    REQUIRE_THROWS_WITH(openAndRead(dir + "/5d.nii"), Contains("only 3D volumes and 4D time series"));
   }
 }
 

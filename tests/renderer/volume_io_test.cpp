@@ -214,11 +214,14 @@ TEST_CASE("a raw volume reads a small box of a 1 GiB file without reading the re
 }
 
 TEST_CASE("openVolumeFile lists the formats it knows", "[io]") {
-  REQUIRE(volumeFormats().size() == 3);
+  REQUIRE(volumeFormats().size() == 4);
   for (const VolumeFormat& f : volumeFormats()) CHECK(std::string(f.extensions).size() > 0);
-  CHECK(volumeFormats()[1].matches("/x/CT.NHDR"));
-  CHECK(volumeFormats()[2].matches("brain.nii.gz"));
-  CHECK_FALSE(volumeFormats()[0].matches("brain.nii.gz"));
+  // The series sidecar comes first: raw+json would take any .json.
+  CHECK(volumeFormats()[0].matches("run.SERIES.json"));
+  CHECK_FALSE(volumeFormats()[0].matches("ct.json"));
+  CHECK(volumeFormats()[2].matches("/x/CT.NHDR"));
+  CHECK(volumeFormats()[3].matches("brain.nii.gz"));
+  CHECK_FALSE(volumeFormats()[1].matches("brain.nii.gz"));
 }
 
 TEST_CASE("writeRawJsonVolume writes what openVolumeFile reads back, voxel for voxel", "[io]") {
