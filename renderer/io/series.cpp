@@ -96,6 +96,9 @@ class SeriesSource final : public VolumeSource {
 };
 
 // One step of steps stored back to back: a box reads from its own offset.
+// It mirrors raw_reader.cpp's RawVolumeSource, which only openRawVolume
+// makes, and that checks the data's size again for every step (for gzip, a
+// whole decode per step); openPackedSteps has checked all steps at once.
 class PackedStepSource final : public VolumeSource {
  public:
   PackedStepSource(std::string name, const GridGeometry& grid, ScalarType type, RawLayout layout)
