@@ -90,7 +90,8 @@ int main(int argc, char** argv) {
 
     const auto source = openSceneVolume(scene.volume);
     resolveDefaults(scene, source->grid());
-    const Brick volume = source->readAll();
+    // The scene's time step of a series (step 0, the volume itself, otherwise).
+    const Brick volume = source->step(scene.volume.timestep).readAll();
 
     RenderOptions options = renderOptionsFor(scene);
     if (args.skip >= 0) options.skipEmpty = args.skip == 1;
