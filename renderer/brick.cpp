@@ -1,10 +1,10 @@
 #include "brick.h"
 
-#include <cmath>
+#include <chrono>
 #include <cstring>
-#include <limits>
 
 #include "error.h"
+#include "preprocess.h"
 
 namespace pvr::core {
 
@@ -25,26 +25,21 @@ double Brick::valueAt(IVec3 node) const {
   });
 }
 
-void Brick::updateValueRange() {
-  range_ = dispatchScalar(type_, [&](auto tag) {
-    using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
-    const T* v = as<T>();
-    const std::size_t n = std::size_t(stored_.nodeCount());
-    double lo = std::numeric_limits<double>::infinity();
-    double hi = -lo;
-    std::uint64_t bad = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double x = double(v[i]);
-      if (!std::isfinite(x)) {
-        ++bad;
-        continue;
-      }
-      lo = std::min(lo, x);
-      hi = std::max(hi, x);
-    }
-    if (lo > hi) lo = hi = 0;  // no finite voxel at all
-    return ValueRange{lo, hi, bad};
-  });
+void Brick::updateValueRange(ThreadPool* pool) {
+  const auto start = std::chrono::steady_clock::now();
+  Preprocessed p = preprocessVoxels(type_, owned_, stored_, data_.data(), pool);
+  range_ = p.range;
+  bounds_ = std::move(p.bounds);
+  loadTimes_.preprocess += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void Brick::setPreprocessed(const ValueRange& range, std::shared_ptr<const MacrocellBounds> bounds) {
+  if (!bounds || bounds->type() != type_ || !(bounds->layout() == MacrocellLayout::forOwned(owned_)))
+    throw Error(ErrorCode::kInternal, "brick " + toString(stored_) +
+                                          ": macrocell bounds are not laid out for its owned box " +
+                                          toString(owned_) + " and scalar type");
+  range_ = range;
+  bounds_ = std::move(bounds);
 }
 
 Brick cropBrick(const Brick& source, const NodeBox& owned, int ghostLayers) {
