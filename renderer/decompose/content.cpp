@@ -39,8 +39,10 @@ ContentGrid makeContentGrid(const GridGeometry& grid, IVec3 blockCells) {
 
 namespace {
 
-// Whether the transfer function shows a voxel of value v; for 8- and 16-bit
-// data one table look-up per voxel, built from TransferTable::anyVisible.
+// Which values the transfer function shows. For 8- and 16-bit data the
+// table is asked once per possible value; when the shown values form one
+// interval [lo, lo + span] (the usual case) a voxel's test is one unsigned
+// compare the compiler vectorises, otherwise one look-up.
 template <typename T>
 class VisibleValues {
  public:
@@ -48,19 +50,44 @@ class VisibleValues {
     if constexpr (!std::is_floating_point_v<T>) {
       const int lo = std::numeric_limits<T>::lowest(), hi = std::numeric_limits<T>::max();
       lut_.resize(std::size_t(hi - lo + 1));
-      for (int v = lo; v <= hi; ++v) lut_[std::size_t(v - lo)] = table.anyVisible(v, v);
+      int runs = 0, first = 0, last = 0;
+      for (int v = lo; v <= hi; ++v) {
+        const bool shown = table.anyVisible(v, v);
+        lut_[std::size_t(v - lo)] = shown;
+        if (shown && (v == lo || !lut_[std::size_t(v - 1 - lo)])) ++runs, first = v;
+        if (shown) last = v;
+      }
+      none_ = runs == 0;
+      oneInterval_ = runs == 1;
+      lo_ = T(first);
+      span_ = U(last - first);
     }
   }
-  std::uint32_t operator()(T v) const {
-    if constexpr (std::is_floating_point_v<T>)
-      return std::isfinite(v) && table_.anyVisible(double(v), double(v));
-    else
-      return lut_[std::size_t(int(v) - int(std::numeric_limits<T>::lowest()))];
+  bool showsNothing() const { return none_; }
+
+  // col[i] += shown(row[i]) for i in [0, n).
+  void addRow(const T* row, std::size_t n, std::uint32_t* col) const {
+    if constexpr (std::is_floating_point_v<T>) {
+      for (std::size_t i = 0; i < n; ++i)
+        col[i] += std::isfinite(row[i]) && table_.anyVisible(double(row[i]), double(row[i]));
+    } else if (oneInterval_) {
+      const T lo = lo_;
+      const U span = span_;
+      for (std::size_t i = 0; i < n; ++i) col[i] += U(U(row[i]) - U(lo)) <= span;
+    } else {
+      const std::uint8_t* lut = lut_.data();
+      for (std::size_t i = 0; i < n; ++i)
+        col[i] += lut[std::size_t(int(row[i]) - int(std::numeric_limits<T>::lowest()))];
+    }
   }
 
  private:
+  using U = std::make_unsigned_t<std::conditional_t<std::is_floating_point_v<T>, int, T>>;
   const TransferTable& table_;
   std::vector<std::uint8_t> lut_;
+  bool none_ = false, oneInterval_ = false;
+  T lo_{};
+  U span_{};
 };
 
 }  // namespace
@@ -77,41 +104,47 @@ ContentGrid countContent(const Brick& brick, const TransferTable& table, IVec3 b
   auto blockOf = [&](int a, std::int64_t n) {
     return std::min(n / c.blockCells[a], c.blocks[a] - 1);
   };
-  // Where block bx's nodes end on x within [own.lo.x, end.x).
-  auto blockEndX = [&](std::int64_t bx) {
-    return bx == c.blocks.x - 1 ? end.x : std::min(end.x, (bx + 1) * c.blockCells.x);
+  // The counted nodes of block b on axis a: [blockBegin, blockEnd).
+  auto blockBegin = [&](int a, std::int64_t b) { return std::max(own.lo[a], b * c.blockCells[a]); };
+  auto blockEnd = [&](int a, std::int64_t b) {
+    return b == c.blocks[a] - 1 ? end[a] : std::min(end[a], (b + 1) * c.blockCells[a]);
   };
+  const IVec3 firstBlock{blockOf(0, own.lo.x), blockOf(1, own.lo.y), blockOf(2, own.lo.z)};
+  const IVec3 lastBlock{blockOf(0, end.x - 1), blockOf(1, end.y - 1), blockOf(2, end.z - 1)};
 
   dispatchScalar(brick.type(), [&](auto tag) {
     using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
     const T* v = brick.as<T>();
     const VisibleValues<T> shows(table);
-    // Layers of blocks go to threads whole, so each count has one writer.
-    const std::int64_t bz0 = blockOf(2, own.lo.z), bz1 = blockOf(2, end.z - 1);
-    auto countLayers = [&](std::int64_t b0, std::int64_t b1) {
-      const std::int64_t z0 = std::max(own.lo.z, b0 * c.blockCells.z);
-      const std::int64_t z1 = b1 > bz1 ? end.z : std::min(end.z, b1 * c.blockCells.z);
-      for (std::int64_t z = z0; z < z1; ++z)
-        for (std::int64_t y = own.lo.y; y < end.y; ++y) {
-          std::uint64_t* rowBlocks =
-              c.counts.data() + std::size_t((blockOf(2, z) * c.blocks.y + blockOf(1, y)) * c.blocks.x);
-          const T* row = v + brick.linearIndex({own.lo.x, y, z});  // row[i] is node own.lo.x + i
-          for (std::int64_t bx = blockOf(0, own.lo.x); bx <= blockOf(0, end.x - 1); ++bx) {
-            std::uint32_t n = 0;
-            const std::int64_t xa = std::max(own.lo.x, bx * c.blockCells.x) - own.lo.x;
-            const std::int64_t xe = blockEndX(bx) - own.lo.x;
-            for (std::int64_t x = xa; x < xe; ++x) n += shows(row[x]);
-            rowBlocks[bx] += n;
+    if (shows.showsNothing()) return;
+    // Per row of blocks: count each column (x) over the block rows' y and
+    // z element by element, then add the columns up per block. Layers of
+    // blocks go to threads whole, so each count has one writer.
+    const std::size_t nx = std::size_t(end.x - own.lo.x);
+    auto countLayers = [&](std::int64_t bz0, std::int64_t bz1) {
+      std::vector<std::uint32_t> col(nx);
+      for (std::int64_t bz = bz0; bz < bz1; ++bz)
+        for (std::int64_t by = firstBlock.y; by <= lastBlock.y; ++by) {
+          std::fill(col.begin(), col.end(), 0);
+          for (std::int64_t z = blockBegin(2, bz); z < blockEnd(2, bz); ++z)
+            for (std::int64_t y = blockBegin(1, by); y < blockEnd(1, by); ++y)
+              shows.addRow(v + brick.linearIndex({own.lo.x, y, z}), nx, col.data());
+          std::uint64_t* counts = c.counts.data() + std::size_t((bz * c.blocks.y + by) * c.blocks.x);
+          for (std::int64_t bx = firstBlock.x; bx <= lastBlock.x; ++bx) {
+            std::uint64_t n = 0;
+            for (std::int64_t x = blockBegin(0, bx); x < blockEnd(0, bx); ++x) n += col[std::size_t(x - own.lo.x)];
+            counts[bx] += n;
           }
         }
     };
-    const std::size_t layers = std::size_t(bz1 - bz0 + 1);
+    const std::size_t layers = std::size_t(lastBlock.z - firstBlock.z + 1);
     const std::size_t chunks = pool ? std::min<std::size_t>(layers, std::size_t(pool->size()) * 4) : 1;
     if (chunks <= 1) {
-      countLayers(bz0, bz1 + 1);
+      countLayers(firstBlock.z, lastBlock.z + 1);
     } else {
       pool->parallelFor(chunks, [&](std::size_t k, int) {
-        countLayers(bz0 + std::int64_t(layers * k / chunks), bz0 + std::int64_t(layers * (k + 1) / chunks));
+        countLayers(firstBlock.z + std::int64_t(layers * k / chunks),
+                    firstBlock.z + std::int64_t(layers * (k + 1) / chunks));
       });
     }
   });

@@ -183,6 +183,17 @@ TransferTable windowTable(ScalarType type) {
   return TransferTable(tf, 0.5);
 }
 
+// Shows every value from 70% of the type's range up: one interval.
+TransferTable upperTable(ScalarType type) {
+  TransferFunctionSpec tf;
+  const double lo = type == ScalarType::kInt16 ? -32768 : type == ScalarType::kFloat32 ? -1000 : 0;
+  const double hi = type == ScalarType::kUInt8 ? 255 : type == ScalarType::kUInt16 ? 65535
+                  : type == ScalarType::kInt16 ? 32767 : 1000;
+  tf.points = {{lo, 0, 0, 0, 0}, {lo + 0.7 * (hi - lo), 0, 0, 0, 0}, {hi, 1, 1, 1, 0.5}};
+  tf.unitDistance = 1;
+  return TransferTable(tf, 0.5);
+}
+
 // Reference content counts: the owned nodes (half-open, closed at the
 // grid's far edge) whose finite value the table shows, per block.
 ContentGrid bruteForceContent(const Brick& b, const TransferTable& table, IVec3 blockCells) {
@@ -315,16 +326,24 @@ TEST_CASE("classification marks a macrocell visible exactly when its bounds are"
 TEST_CASE("content counts equal brute force for every scalar type, single-threaded and on a pool", "[preprocess]") {
   ThreadPool pool(2);
   std::uint32_t seed = 100;
+  TransferFunctionSpec invisible;
+  invisible.points = {{0, 1, 1, 1, 0}, {1, 1, 1, 1, 0}};
+  invisible.unitDistance = 1;
   for (ScalarType type : kTypes)
     for (const NodeBox& owned : kOwnedBoxes)
       for (IVec3 blockCells : {IVec3{8, 8, 8}, IVec3{3, 5, 7}}) {
         CAPTURE(scalarName(type), toString(owned), blockCells.x, blockCells.y);
         const Brick b = randomBrick(type, owned, 1, seed++);
-        const TransferTable table = windowTable(type);
-        const ContentGrid want = bruteForceContent(b, table, blockCells);
-        REQUIRE(totalContent(want) > 0);
-        CHECK(countContent(b, table, blockCells).counts == want.counts);
-        CHECK(countContent(b, table, blockCells, &pool).counts == want.counts);
+        // Two shown intervals, one, and none at all.
+        const TransferTable tables[] = {windowTable(type), upperTable(type), TransferTable(invisible, 0.5)};
+        for (const TransferTable& table : tables) {
+          const ContentGrid want = bruteForceContent(b, table, blockCells);
+          CHECK(countContent(b, table, blockCells).counts == want.counts);
+          CHECK(countContent(b, table, blockCells, &pool).counts == want.counts);
+        }
+        CHECK(totalContent(bruteForceContent(b, tables[0], blockCells)) > 0);
+        CHECK(totalContent(bruteForceContent(b, tables[1], blockCells)) > 0);
+        CHECK(totalContent(bruteForceContent(b, tables[2], blockCells)) == 0);
       }
 }
 
