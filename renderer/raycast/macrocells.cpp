@@ -23,7 +23,7 @@ void forChunks(std::size_t n, ThreadPool* pool, F&& body) {
   pool->parallelFor(chunks, [&](std::size_t c, int) { body(n * c / chunks, n * (c + 1) / chunks); });
 }
 
-// The 1-D min-max transform of one line, in place:
+// The 1-D min-max transform of a line, in place:
 //   d(i) = min(255, min over q of max(|i - q|, f(q))).
 // Applied along x to the 0/255 visibility it gives the distance along x;
 // applied next along y and then z to the previous result it gives the 3-D
@@ -34,63 +34,85 @@ void forChunks(std::size_t n, ThreadPool* pool, F&& body) {
 // of i, and the latest such q is remembered per value. Positions are
 // stamped with a base that grows from line to line, so a stale entry is
 // always too far back to count and the table needs no clearing.
+//
+// A step's look-up depends on the step before, so kLanes neighbouring
+// lines go in lockstep: their chains are independent and overlap in the
+// CPU, and they share cache lines.
 class MinMaxLines {
  public:
-  MinMaxLines() { std::fill(std::begin(last_), std::end(last_), std::numeric_limits<std::int64_t>::min() / 2); }
+  static constexpr int kLanes = 8;
 
-  void transform(std::uint8_t* f, std::ptrdiff_t stride, std::int64_t n) {
-    forward_.resize(std::size_t(n));
-    sweep(n, [&](std::int64_t k) -> std::uint8_t& { return f[k * stride]; },
-          [&](std::int64_t k, int a) { forward_[std::size_t(k)] = std::uint8_t(a); });
-    sweep(n, [&](std::int64_t k) -> std::uint8_t& { return f[(n - 1 - k) * stride]; },
-          [&](std::int64_t k, int a) {
-            std::uint8_t& out = f[(n - 1 - k) * stride];
-            out = std::uint8_t(std::min<int>(a, forward_[std::size_t(n - 1 - k)]));
+  // Transforms `lines` (1..kLanes) lines of n elements each: element k of
+  // line j is f[j * lineStep + k * stride].
+  void transform(std::uint8_t* f, std::ptrdiff_t lineStep, int lines, std::ptrdiff_t stride, std::int64_t n) {
+    if (base_ > kMaxBase - 2 * (n + kFar + 1)) reset();
+    forward_.resize(std::size_t(n) * kLanes);
+    sweep(n, lines, [&](int j, std::int64_t k) -> std::uint8_t& { return f[j * lineStep + k * stride]; },
+          [&](int j, std::int64_t k, int a) { forward_[std::size_t(k) * kLanes + std::size_t(j)] = std::uint8_t(a); });
+    sweep(n, lines, [&](int j, std::int64_t k) -> std::uint8_t& { return f[j * lineStep + (n - 1 - k) * stride]; },
+          [&](int j, std::int64_t k, int a) {
+            std::uint8_t& out = f[j * lineStep + (n - 1 - k) * stride];
+            out = std::uint8_t(std::min<int>(a, forward_[std::size_t(n - 1 - k) * kLanes + std::size_t(j)]));
           });
   }
 
  private:
-  // One direction; at(k) is the k-th element in sweep order, done(k, a) is
-  // called after it was read with the one-sided result a.
-  template <typename At, typename Done>
-  void sweep(std::int64_t n, At&& at, Done&& done) {
-    int prev = kFar;
-    for (std::int64_t k = 0; k < n; ++k) {
-      const int fk = at(k);
-      const int a = prev >= kFar ? kFar : (last_[prev] >= base_ + k - prev ? prev : prev + 1);
-      prev = std::min(fk, a);
-      last_[fk] = base_ + k;
-      done(k, prev);
-    }
-    base_ += n + kFar + 1;
+  static constexpr std::int32_t kMaxBase = std::int32_t(1) << 30;
+
+  void reset() {
+    for (auto& lane : last_) std::fill(std::begin(lane), std::end(lane), -kMaxBase);
+    base_ = 0;
   }
 
-  std::int64_t last_[kFar + 1];
-  std::int64_t base_ = 0;
+  // One direction; at(j, k) is line j's k-th element in sweep order,
+  // done(j, k, a) is called after it was read with the one-sided result a.
+  template <typename At, typename Done>
+  void sweep(std::int64_t n, int lines, At&& at, Done&& done) {
+    int prev[kLanes];
+    std::fill(std::begin(prev), std::end(prev), kFar);
+    for (std::int64_t k = 0; k < n; ++k) {
+      const std::int32_t here = base_ + std::int32_t(k);
+      for (int j = 0; j < lines; ++j) {
+        const int fk = at(j, k);
+        const int p = prev[j];
+        const int a = p >= kFar ? kFar : (last_[j][p] >= here - p ? p : p + 1);
+        prev[j] = std::min(fk, a);
+        last_[j][fk] = here;
+        done(j, k, prev[j]);
+      }
+    }
+    base_ += std::int32_t(n) + kFar + 1;
+  }
+
+  std::int32_t last_[kLanes][kFar + 1];
+  std::int32_t base_ = kMaxBase;  // forces a reset before the first line
   std::vector<std::uint8_t> forward_;
 };
 
 }  // namespace
 
 void chessboardDistance(std::uint8_t* d, IVec3 count, ThreadPool* pool) {
+  constexpr int kLanes = MinMaxLines::kLanes;
   const std::int64_t nx = count.x, ny = count.y, nz = count.z;
-  // Along x: one line per (y, z).
-  forChunks(std::size_t(ny * nz), pool, [&](std::size_t b, std::size_t e) {
+  auto lanesFrom = [](std::int64_t i, std::int64_t end) { return int(std::min<std::int64_t>(kLanes, end - i)); };
+  // Along x: one line per (y, z), kLanes rows at a time.
+  const std::int64_t rows = ny * nz, rowGroups = (rows + kLanes - 1) / kLanes;
+  forChunks(std::size_t(rowGroups), pool, [&](std::size_t b, std::size_t e) {
     MinMaxLines lines;
-    for (std::size_t r = b; r < e; ++r) lines.transform(d + std::int64_t(r) * nx, 1, nx);
+    for (std::int64_t r = std::int64_t(b) * kLanes; r < std::min(rows, std::int64_t(e) * kLanes); r += kLanes)
+      lines.transform(d + r * nx, nx, lanesFrom(r, rows), 1, nx);
   });
-  // Along y: one line per (x, z), neighbours in x one after another so the
-  // lines share cache lines.
+  // Along y: one line per (x, z), kLanes neighbours in x at a time.
   forChunks(std::size_t(nz), pool, [&](std::size_t b, std::size_t e) {
     MinMaxLines lines;
-    for (std::size_t z = b; z < e; ++z)
-      for (std::int64_t x = 0; x < nx; ++x) lines.transform(d + std::int64_t(z) * nx * ny + x, nx, ny);
+    for (std::int64_t z = std::int64_t(b); z < std::int64_t(e); ++z)
+      for (std::int64_t x = 0; x < nx; x += kLanes) lines.transform(d + z * nx * ny + x, 1, lanesFrom(x, nx), nx, ny);
   });
   // Along z: one line per (x, y).
   forChunks(std::size_t(ny), pool, [&](std::size_t b, std::size_t e) {
     MinMaxLines lines;
-    for (std::size_t y = b; y < e; ++y)
-      for (std::int64_t x = 0; x < nx; ++x) lines.transform(d + std::int64_t(y) * nx + x, nx * ny, nz);
+    for (std::int64_t y = std::int64_t(b); y < std::int64_t(e); ++y)
+      for (std::int64_t x = 0; x < nx; x += kLanes) lines.transform(d + y * nx + x, 1, lanesFrom(x, nx), nx * ny, nz);
   });
 }
 
