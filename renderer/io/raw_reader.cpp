@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <cstring>
 
 #include "byte_stream.h"
 #include "gzip_stream.h"
@@ -13,9 +14,23 @@ namespace pvr::core {
 
 namespace {
 
+// Reverses the bytes of each of `count` scalars of `size` bytes (2 or 4).
 void swapBytesInPlace(std::byte* data, std::size_t count, std::size_t size) {
-  for (std::size_t i = 0; i < count; ++i)
-    std::reverse(data + i * size, data + (i + 1) * size);
+  if (size == 2) {
+    for (std::size_t i = 0; i < count; ++i) {
+      std::uint16_t v;
+      std::memcpy(&v, data + 2 * i, 2);
+      v = std::uint16_t(v << 8 | v >> 8);
+      std::memcpy(data + 2 * i, &v, 2);
+    }
+  } else {
+    for (std::size_t i = 0; i < count; ++i) {
+      std::uint32_t v;
+      std::memcpy(&v, data + 4 * i, 4);
+      v = __builtin_bswap32(v);
+      std::memcpy(data + 4 * i, &v, 4);
+    }
+  }
 }
 
 std::unique_ptr<ByteStream> openStream(const RawLayout& layout) {

@@ -28,7 +28,6 @@ class MacrocellGrid {
   static constexpr int kShift = MacrocellLayout::kShift;
   static constexpr int kSize = MacrocellLayout::kSize;
 
-  MacrocellGrid() = default;
   // Takes the brick's bounds, or computes them (over the pool's threads
   // when one is given) if the brick carries none.
   explicit MacrocellGrid(const Brick& brick, ThreadPool* pool = nullptr);

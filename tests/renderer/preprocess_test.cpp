@@ -261,7 +261,7 @@ TEST_CASE("a float brick without a finite voxel has the range [0, 0] and only em
   for (std::size_t i = 0; i < bounds.layout().size(); ++i) CHECK(bounds.minAt(i) > bounds.maxAt(i));
 }
 
-TEST_CASE("writing a brick's voxels drops its macrocell bounds; updateValueRange brings them back", "[preprocess]") {
+TEST_CASE("writing a brick's voxels drops its macrocell bounds and updateValueRange brings them back", "[preprocess]") {
   Brick b = randomBrick(ScalarType::kUInt8, kOwnedBoxes[2], 1, 7);
   b.updateValueRange();
   REQUIRE(b.macrocellBounds());
