@@ -1,5 +1,6 @@
 #include "brick.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 
@@ -8,13 +9,24 @@
 
 namespace pvr::core {
 
-Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored)
+Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored, Unwritten)
     : grid_(grid), type_(type), owned_(owned), stored_(stored) {
   if (owned.empty() || !stored.contains(owned) || !grid.allNodes().contains(stored))
     throw Error(ErrorCode::kInvalidArgument,
                 "brick: owned box " + toString(owned) + " must lie in stored box " +
                     toString(stored) + " inside the grid " + toString(grid.allNodes()));
   data_.resize(std::size_t(stored.nodeCount()) * scalarSize(type) + kPaddingBytes);
+  std::fill(data_.end() - kPaddingBytes, data_.end(), std::byte{0});
+}
+
+Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored)
+    : Brick(grid, type, owned, stored, Unwritten{}) {
+  std::fill(data_.begin(), data_.end(), std::byte{0});
+}
+
+Brick Brick::forOverwrite(const GridGeometry& grid, ScalarType type, const NodeBox& owned,
+                          const NodeBox& stored) {
+  return Brick(grid, type, owned, stored, Unwritten{});
 }
 
 double Brick::valueAt(IVec3 node) const {
@@ -48,7 +60,7 @@ Brick cropBrick(const Brick& source, const NodeBox& owned, int ghostLayers) {
     throw Error(ErrorCode::kInvalidArgument, "cropBrick: " + toString(stored) +
                                                  " is not inside the source brick " +
                                                  toString(source.stored()));
-  Brick out(source.grid(), source.type(), owned, stored);
+  Brick out = Brick::forOverwrite(source.grid(), source.type(), owned, stored);  // every row is copied below
   const std::size_t size = scalarSize(source.type());
   const std::size_t rowBytes = std::size_t(stored.extent(0)) * size;
   for (std::int64_t z = stored.lo.z; z <= stored.hi.z; ++z)

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "grid.h"
@@ -43,6 +44,11 @@ class Brick {
   // Zero-filled storage for `stored`; throws if stored does not contain owned
   // or lies outside the grid.
   Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored);
+  // The same with the voxels left unwritten (the padding is zero), for
+  // readers that write every voxel: zero-filling first would touch every
+  // page of a gigabyte brick once more.
+  static Brick forOverwrite(const GridGeometry& grid, ScalarType type, const NodeBox& owned,
+                            const NodeBox& stored);
 
   const GridGeometry& grid() const { return grid_; }
   ScalarType type() const { return type_; }
@@ -90,11 +96,24 @@ class Brick {
   const LoadTimes& loadTimes() const { return loadTimes_; }
 
  private:
+  // std::allocator, except that resize() leaves new bytes unwritten.
+  template <typename T>
+  struct UnwrittenAllocator : std::allocator<T> {
+    template <typename U> struct rebind { using other = UnwrittenAllocator<U>; };
+    using std::allocator<T>::allocator;
+    template <typename U> void construct(U* p) noexcept { ::new (static_cast<void*>(p)) U; }
+    template <typename U, typename... A> void construct(U* p, A&&... args) {
+      ::new (static_cast<void*>(p)) U(std::forward<A>(args)...);
+    }
+  };
+  struct Unwritten {};
+  Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored, Unwritten);
+
   GridGeometry grid_;
   ScalarType type_ = ScalarType::kUInt8;
   NodeBox owned_;
   NodeBox stored_;
-  std::vector<std::byte> data_;
+  std::vector<std::byte, UnwrittenAllocator<std::byte>> data_;
   ValueRange range_;
   std::shared_ptr<const MacrocellBounds> bounds_;
   LoadTimes loadTimes_;

@@ -90,7 +90,7 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
   using Clock = std::chrono::steady_clock;
   auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   checkReadBoxes(layout.dataPath, grid, owned, stored);
-  Brick brick(grid, type, owned, stored);
+  Brick brick = Brick::forOverwrite(grid, type, owned, stored);  // every voxel is read below
   const std::size_t size = scalarSize(type);
   const IVec3 d = grid.dims;
   const IVec3 e = stored.extents();
