@@ -1,7 +1,6 @@
 #include "preprocess.h"
 
 #include <algorithm>
-#include <limits>
 #include <type_traits>
 #include <vector>
 
