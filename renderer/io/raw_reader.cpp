@@ -4,6 +4,7 @@
 #include <bit>
 #include <chrono>
 #include <cstring>
+#include <vector>
 
 #include "byte_stream.h"
 #include "gzip_stream.h"
@@ -106,6 +107,14 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
       wholeSlabs ? std::clamp<std::int64_t>(std::int64_t(kSlabGroupBytes / slabBytes), 1, e.z) : 1;
   const std::int64_t runsY = wholeRows ? 1 : e.y;
   const std::size_t rowRunBytes = std::size_t(e.x * (wholeRows ? e.y : 1)) * size;
+  // Short rows cost a call each; below kShortRowBytes one call reads the
+  // span from a slab's first row to its last, gaps included, into a
+  // buffer of at most one whole-width slab, and the rows are copied out.
+  // The gaps share the rows' disk pages anyway.
+  constexpr std::size_t kShortRowBytes = std::size_t(16) << 10;
+  const bool spans = !wholeRows && rowRunBytes < kShortRowBytes;
+  const std::size_t rowPitch = std::size_t(d.x) * size;  // file bytes from one row to the next
+  std::vector<std::byte> span(spans ? std::size_t(e.y - 1) * rowPitch + rowRunBytes : 0);
 
   // Step: read the groups of slabs in file order (a gzip stream only goes
   // forward), bring each to host order and preprocess it while it is in
@@ -122,6 +131,11 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
       if (wholeSlabs) {
         const std::uint64_t node = std::uint64_t(z0 * d.y * d.x);
         stream->read(layout.offset + node * size, group, std::size_t(z1 - z0 + 1) * slabBytes);
+      } else if (spans) {
+        const std::uint64_t node = std::uint64_t((z0 * d.y + stored.lo.y) * d.x + stored.lo.x);
+        stream->read(layout.offset + node * size, span.data(), span.size());
+        for (std::int64_t j = 0; j < e.y; ++j)
+          std::memcpy(group + std::size_t(j) * rowRunBytes, span.data() + std::size_t(j) * rowPitch, rowRunBytes);
       } else {
         std::byte* dst = group;
         for (std::int64_t j = 0; j < runsY; ++j, dst += rowRunBytes) {

@@ -390,6 +390,27 @@ TEST_CASE("the raw reader's fused preprocessing equals reading, then preprocessi
     }
 }
 
+TEST_CASE("the raw reader reads long rows one call each and short rows in spans, the same voxels", "[preprocess][io]") {
+  // float32 rows of 4400 nodes: a brick 4300 wide has rows of 17200 bytes,
+  // above the reader's 16 KiB span threshold; one 300 wide stays below it.
+  const std::string dir = test::scratchDir("preprocess_rows");
+  const GridGeometry grid = gridOf({4400, 5, 4});
+  Brick whole(grid, ScalarType::kFloat32, grid.allNodes(), grid.allNodes());
+  float* v = whole.as<float>();
+  for (std::int64_t i = 0; i < grid.allNodes().nodeCount(); ++i) v[i] = float(i % 9973) * 0.5f;
+  whole.updateValueRange();
+  const auto source = openVolumeFile(writeRawJsonVolume(whole, dir, "rows", "long rows"));
+  for (const NodeBox owned : {NodeBox{{50, 1, 1}, {4349, 3, 2}}, NodeBox{{1000, 0, 0}, {1299, 4, 3}}}) {
+    CAPTURE(toString(owned));
+    const Brick fused = source->readBox(owned, owned.grown(1).intersect(grid.allNodes()));
+    const Brick twoPass = cropBrick(whole, owned, 1);
+    REQUIRE(fused.byteSize() == twoPass.byteSize());
+    CHECK(std::memcmp(fused.bytes(), twoPass.bytes(), fused.byteSize()) == 0);
+    CHECK(sameBounds(*fused.macrocellBounds(), *twoPass.macrocellBounds()));
+    checkRange(fused.valueRange(), twoPass.valueRange());
+  }
+}
+
 TEST_CASE("a brick renders the same with the bounds it carries as with bounds the renderer computes", "[preprocess]") {
   const GridGeometry grid = gridOf({33, 30, 27});
   Brick carried(grid, ScalarType::kUInt16, grid.allNodes(), grid.allNodes());
