@@ -39,8 +39,9 @@ ContentGrid makeContentGrid(const GridGeometry& grid, IVec3 blockCells) {
 
 namespace {
 
-// Which values the transfer function shows. For 8- and 16-bit data the
-// table is asked once per possible value; when the shown values form one
+// Which values the transfer function shows. For float data the table is
+// asked per voxel, except in pieces of a row it shows nothing of. For 8-
+// and 16-bit data it is asked once per possible value; when the shown values form one
 // interval [lo, lo + span] (the usual case) a voxel's test is one unsigned
 // compare the compiler vectorises, otherwise one look-up.
 template <typename T>
@@ -68,8 +69,22 @@ class VisibleValues {
   // col[i] += shown(row[i]) for i in [0, n).
   void addRow(const T* row, std::size_t n, std::uint32_t* col) const {
     if constexpr (std::is_floating_point_v<T>) {
-      for (std::size_t i = 0; i < n; ++i)
-        col[i] += std::isfinite(row[i]) && table_.anyVisible(double(row[i]), double(row[i]));
+      // Pieces whose finite range the table shows nothing of are skipped
+      // whole: anyVisible(lo, hi) holds whenever anyVisible(v, v) does for
+      // some v in [lo, hi]. The rest ask the table voxel by voxel.
+      constexpr std::size_t kPiece = 64;
+      for (std::size_t p = 0; p < n; p += kPiece) {
+        const std::size_t e = std::min(n, p + kPiece);
+        T lo = std::numeric_limits<T>::infinity(), hi = -lo;
+        for (std::size_t i = p; i < e; ++i) {
+          const bool finite = (row[i] - row[i]) == T(0);
+          lo = std::min(lo, finite ? row[i] : lo);
+          hi = std::max(hi, finite ? row[i] : hi);
+        }
+        if (!(lo <= hi) || !table_.anyVisible(double(lo), double(hi))) continue;
+        for (std::size_t i = p; i < e; ++i)
+          col[i] += std::isfinite(row[i]) && table_.anyVisible(double(row[i]), double(row[i]));
+      }
     } else if (oneInterval_) {
       const T lo = lo_;
       const U span = span_;
