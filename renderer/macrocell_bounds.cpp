@@ -1,7 +1,6 @@
 #include "macrocell_bounds.h"
 
 #include <algorithm>
-#include <cstring>
 
 #include "brick.h"
 
