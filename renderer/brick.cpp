@@ -1,20 +1,32 @@
 #include "brick.h"
 
-#include <cmath>
+#include <algorithm>
+#include <chrono>
 #include <cstring>
-#include <limits>
 
 #include "error.h"
+#include "preprocess.h"
 
 namespace pvr::core {
 
-Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored)
+Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored, Unwritten)
     : grid_(grid), type_(type), owned_(owned), stored_(stored) {
   if (owned.empty() || !stored.contains(owned) || !grid.allNodes().contains(stored))
     throw Error(ErrorCode::kInvalidArgument,
                 "brick: owned box " + toString(owned) + " must lie in stored box " +
                     toString(stored) + " inside the grid " + toString(grid.allNodes()));
   data_.resize(std::size_t(stored.nodeCount()) * scalarSize(type) + kPaddingBytes);
+  std::fill(data_.end() - kPaddingBytes, data_.end(), std::byte{0});
+}
+
+Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored)
+    : Brick(grid, type, owned, stored, Unwritten{}) {
+  std::fill(data_.begin(), data_.end(), std::byte{0});
+}
+
+Brick Brick::forOverwrite(const GridGeometry& grid, ScalarType type, const NodeBox& owned,
+                          const NodeBox& stored) {
+  return Brick(grid, type, owned, stored, Unwritten{});
 }
 
 double Brick::valueAt(IVec3 node) const {
@@ -25,26 +37,21 @@ double Brick::valueAt(IVec3 node) const {
   });
 }
 
-void Brick::updateValueRange() {
-  range_ = dispatchScalar(type_, [&](auto tag) {
-    using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
-    const T* v = as<T>();
-    const std::size_t n = std::size_t(stored_.nodeCount());
-    double lo = std::numeric_limits<double>::infinity();
-    double hi = -lo;
-    std::uint64_t bad = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double x = double(v[i]);
-      if (!std::isfinite(x)) {
-        ++bad;
-        continue;
-      }
-      lo = std::min(lo, x);
-      hi = std::max(hi, x);
-    }
-    if (lo > hi) lo = hi = 0;  // no finite voxel at all
-    return ValueRange{lo, hi, bad};
-  });
+void Brick::updateValueRange(ThreadPool* pool) {
+  const auto start = std::chrono::steady_clock::now();
+  Preprocessed p = preprocessVoxels(type_, owned_, stored_, data_.data(), pool);
+  range_ = p.range;
+  bounds_ = std::move(p.bounds);
+  loadTimes_.preprocess += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void Brick::setPreprocessed(const ValueRange& range, std::shared_ptr<const MacrocellBounds> bounds) {
+  if (!bounds || bounds->type() != type_ || !(bounds->layout() == MacrocellLayout::forOwned(owned_)))
+    throw Error(ErrorCode::kInternal, "brick " + toString(stored_) +
+                                          ": macrocell bounds are not laid out for its owned box " +
+                                          toString(owned_) + " and scalar type");
+  range_ = range;
+  bounds_ = std::move(bounds);
 }
 
 Brick cropBrick(const Brick& source, const NodeBox& owned, int ghostLayers) {
@@ -53,7 +60,7 @@ Brick cropBrick(const Brick& source, const NodeBox& owned, int ghostLayers) {
     throw Error(ErrorCode::kInvalidArgument, "cropBrick: " + toString(stored) +
                                                  " is not inside the source brick " +
                                                  toString(source.stored()));
-  Brick out(source.grid(), source.type(), owned, stored);
+  Brick out = Brick::forOverwrite(source.grid(), source.type(), owned, stored);  // every row is copied below
   const std::size_t size = scalarSize(source.type());
   const std::size_t rowBytes = std::size_t(stored.extent(0)) * size;
   for (std::int64_t z = stored.lo.z; z <= stored.hi.z; ++z)

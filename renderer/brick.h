@@ -9,21 +9,29 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "grid.h"
+#include "macrocell_bounds.h"
 
 namespace pvr::core {
 
-// The finite values of a brick. Non-finite voxels (NaN, Inf) are counted, not
-// ranged: they classify as empty wherever they are sampled.
-// Seconds spent filling a brick: in I/O, and in preprocessing done while
-// the data was read (value range, macrocell bounds). Readers set it.
+class ThreadPool;
+
+// Seconds spent filling a brick: `read` in I/O calls (readers set it),
+// `preprocess` computing its value range and macrocell bounds (the fused
+// pass of a reader, or updateValueRange()). A brick that carries no bounds
+// gets them from the MacrocellGrid its BrickRenderer builds; that time is
+// BrickRenderer::preprocessSeconds(), not part of these.
 struct LoadTimes {
   double read = 0;
   double preprocess = 0;
 };
 
+// The finite values of a brick. Non-finite voxels (NaN, Inf) are counted, not
+// ranged: they classify as empty wherever they are sampled.
 struct ValueRange {
   double min = 0;
   double max = 0;
@@ -36,19 +44,29 @@ class Brick {
   // Zero-filled storage for `stored`; throws if stored does not contain owned
   // or lies outside the grid.
   Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored);
+  // The same with the voxels left unwritten (the padding is zero), for
+  // readers that write every voxel: zero-filling first would touch every
+  // page of a gigabyte brick once more.
+  static Brick forOverwrite(const GridGeometry& grid, ScalarType type, const NodeBox& owned,
+                            const NodeBox& stored);
 
   const GridGeometry& grid() const { return grid_; }
   ScalarType type() const { return type_; }
   const NodeBox& owned() const { return owned_; }
   const NodeBox& stored() const { return stored_; }
 
-  std::byte* bytes() { return data_.data(); }
+  // Writable access drops the macrocell bounds (the voxels may no longer
+  // match them); updateValueRange() computes them again.
+  std::byte* bytes() {
+    bounds_.reset();
+    return data_.data();
+  }
   const std::byte* bytes() const { return data_.data(); }
   std::size_t byteSize() const { return data_.size() - kPaddingBytes; }
   // Storage ends with this many zero bytes, so the vector kernel may load a
   // 32-bit word at the last voxel of any scalar type.
   static constexpr std::size_t kPaddingBytes = 8;
-  template <typename T> T* as() { return reinterpret_cast<T*>(data_.data()); }
+  template <typename T> T* as() { return reinterpret_cast<T*>(bytes()); }
   template <typename T> const T* as() const { return reinterpret_cast<const T*>(data_.data()); }
 
   // Linear index into storage of a global node inside `stored`.
@@ -60,20 +78,44 @@ class Brick {
   // One voxel as double; for tests, references and set-up, not for hot loops.
   double valueAt(IVec3 node) const;
 
-  // Recomputes the finite value range; loaders call it after filling storage.
-  void updateValueRange();
+  // Recomputes the finite value range and the macrocell bounds from storage
+  // in one pass (preprocess.h), over `pool`'s threads when one is given,
+  // the same result either way. Loaders call it after filling storage; its
+  // seconds add to loadTimes().preprocess.
+  void updateValueRange(ThreadPool* pool = nullptr);
   const ValueRange& valueRange() const { return range_; }
+  // For readers that preprocessed the voxels as they landed. Throws if the
+  // bounds are not laid out for this brick's owned box and scalar type.
+  void setPreprocessed(const ValueRange& range, std::shared_ptr<const MacrocellBounds> bounds);
+  // The macrocell bounds of the owned box, or null when storage was written
+  // since they were computed (or they never were). Shared, never copied:
+  // the renderer's MacrocellGrid holds the same object.
+  const std::shared_ptr<const MacrocellBounds>& macrocellBounds() const { return bounds_; }
 
   LoadTimes& loadTimes() { return loadTimes_; }
   const LoadTimes& loadTimes() const { return loadTimes_; }
 
  private:
+  // std::allocator, except that resize() leaves new bytes unwritten.
+  template <typename T>
+  struct UnwrittenAllocator : std::allocator<T> {
+    template <typename U> struct rebind { using other = UnwrittenAllocator<U>; };
+    using std::allocator<T>::allocator;
+    template <typename U> void construct(U* p) noexcept { ::new (static_cast<void*>(p)) U; }
+    template <typename U, typename... A> void construct(U* p, A&&... args) {
+      ::new (static_cast<void*>(p)) U(std::forward<A>(args)...);
+    }
+  };
+  struct Unwritten {};
+  Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored, Unwritten);
+
   GridGeometry grid_;
   ScalarType type_ = ScalarType::kUInt8;
   NodeBox owned_;
   NodeBox stored_;
-  std::vector<std::byte> data_;
+  std::vector<std::byte, UnwrittenAllocator<std::byte>> data_;
   ValueRange range_;
+  std::shared_ptr<const MacrocellBounds> bounds_;
   LoadTimes loadTimes_;
 };
 

@@ -18,6 +18,8 @@
 
 namespace pvr::core {
 
+class ThreadPool;
+
 // A zero grid shaped for `grid`: ceil(cells / blockCells) blocks per axis,
 // at least one (an axis without cells has one block). Node n falls in block
 // min(n / blockCells, blocks - 1). Throws if a blockCells entry is < 1.
@@ -26,8 +28,11 @@ ContentGrid makeContentGrid(const GridGeometry& grid, IVec3 blockCells = {8, 8, 
 // Counts the finite voxels of `brick` (owned half-open, see above) for
 // which table.anyVisible(v, v): a value the transfer function gives
 // non-zero opacity (conservatively, as macrocell skipping decides it).
+// 8- and 16-bit data look each value up in a table built once per call.
+// Layers of blocks spread over the pool's threads when one is given; the
+// counts do not depend on it.
 ContentGrid countContent(const Brick& brick, const TransferTable& table,
-                         IVec3 blockCells = {8, 8, 8});
+                         IVec3 blockCells = {8, 8, 8}, ThreadPool* pool = nullptr);
 
 // sum += part, element by element. Throws if the two differ in shape.
 void addContent(ContentGrid& sum, const ContentGrid& part);

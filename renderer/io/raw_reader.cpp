@@ -2,18 +2,36 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
+#include <cstring>
+#include <vector>
 
 #include "byte_stream.h"
 #include "gzip_stream.h"
+#include "preprocess.h"
 #include "source_util.h"
 
 namespace pvr::core {
 
 namespace {
 
+// Reverses the bytes of each of `count` scalars of `size` bytes (2 or 4).
 void swapBytesInPlace(std::byte* data, std::size_t count, std::size_t size) {
-  for (std::size_t i = 0; i < count; ++i)
-    std::reverse(data + i * size, data + (i + 1) * size);
+  if (size == 2) {
+    for (std::size_t i = 0; i < count; ++i) {
+      std::uint16_t v;
+      std::memcpy(&v, data + 2 * i, 2);
+      v = std::uint16_t(v << 8 | v >> 8);
+      std::memcpy(data + 2 * i, &v, 2);
+    }
+  } else {
+    for (std::size_t i = 0; i < count; ++i) {
+      std::uint32_t v;
+      std::memcpy(&v, data + 4 * i, 4);
+      v = __builtin_bswap32(v);
+      std::memcpy(data + 4 * i, &v, 4);
+    }
+  }
 }
 
 std::unique_ptr<ByteStream> openStream(const RawLayout& layout) {
@@ -70,41 +88,73 @@ std::unique_ptr<VolumeSource> openRawVolume(std::string name, const GridGeometry
 
 Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType type,
                  const NodeBox& owned, const NodeBox& stored) {
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   checkReadBoxes(layout.dataPath, grid, owned, stored);
-  Brick brick(grid, type, owned, stored);
+  Brick brick = Brick::forOverwrite(grid, type, owned, stored);  // every voxel is read below
   const std::size_t size = scalarSize(type);
   const IVec3 d = grid.dims;
   const IVec3 e = stored.extents();
 
-  // Step: find the longest contiguous run. Whole x rows make a y-slab one
-  // run; whole slabs make the entire box one run.
+  // Step: find the longest contiguous run. Whole x rows make a slab one
+  // run; whole slabs make several slabs one run, up to kSlabGroupBytes, a
+  // size that stays in cache until it is preprocessed.
+  constexpr std::size_t kSlabGroupBytes = std::size_t(1) << 20;
   const bool wholeRows = e.x == d.x;
   const bool wholeSlabs = wholeRows && e.y == d.y;
+  const std::size_t slabBytes = std::size_t(e.x * e.y) * size;
+  const std::int64_t slabsPerGroup =
+      wholeSlabs ? std::clamp<std::int64_t>(std::int64_t(kSlabGroupBytes / slabBytes), 1, e.z) : 1;
   const std::int64_t runsY = wholeRows ? 1 : e.y;
-  const std::int64_t runsZ = wholeSlabs ? 1 : e.z;
-  const std::size_t runBytes =
-      std::size_t(e.x * (wholeRows ? e.y : 1) * (wholeSlabs ? e.z : 1)) * size;
+  const std::size_t rowRunBytes = std::size_t(e.x * (wholeRows ? e.y : 1)) * size;
+  // Short rows cost a call each; below kShortRowBytes one call reads the
+  // span from a slab's first row to its last, gaps included, into a
+  // buffer of at most one whole-width slab, and the rows are copied out.
+  // The gaps share the rows' disk pages anyway.
+  constexpr std::size_t kShortRowBytes = std::size_t(16) << 10;
+  const bool spans = !wholeRows && rowRunBytes < kShortRowBytes;
+  const std::size_t rowPitch = std::size_t(d.x) * size;  // file bytes from one row to the next
+  std::vector<std::byte> span(spans ? std::size_t(e.y - 1) * rowPitch + rowRunBytes : 0);
 
-  // Step: read the runs in file order (a gzip stream only goes forward).
+  // Step: read the groups of slabs in file order (a gzip stream only goes
+  // forward), bring each to host order and preprocess it while it is in
+  // cache: the voxels are touched once.
+  const bool swap = size > 1 && layout.bigEndian != (std::endian::native == std::endian::big);
+  SlabPreprocessor pre(type, owned, stored);
+  std::byte* voxels = brick.bytes();
   withHeaderNamed(layout, [&] {
     std::unique_ptr<ByteStream> stream = openStream(layout);
-    std::byte* dst = brick.bytes();
-    for (std::int64_t k = 0; k < runsZ; ++k) {
-      for (std::int64_t j = 0; j < runsY; ++j) {
-        const std::int64_t z = stored.lo.z + k;
-        const std::int64_t y = stored.lo.y + j;
-        const std::uint64_t node = std::uint64_t((z * d.y + y) * d.x + stored.lo.x);
-        stream->read(layout.offset + node * size, dst, runBytes);
-        dst += runBytes;
+    for (std::int64_t z0 = stored.lo.z; z0 <= stored.hi.z; z0 += slabsPerGroup) {
+      const std::int64_t z1 = std::min(stored.hi.z, z0 + slabsPerGroup - 1);
+      std::byte* group = voxels + std::size_t(z0 - stored.lo.z) * slabBytes;
+      const auto readStart = Clock::now();
+      if (wholeSlabs) {
+        const std::uint64_t node = std::uint64_t(z0 * d.y * d.x);
+        stream->read(layout.offset + node * size, group, std::size_t(z1 - z0 + 1) * slabBytes);
+      } else if (spans) {
+        const std::uint64_t node = std::uint64_t((z0 * d.y + stored.lo.y) * d.x + stored.lo.x);
+        stream->read(layout.offset + node * size, span.data(), span.size());
+        for (std::int64_t j = 0; j < e.y; ++j)
+          std::memcpy(group + std::size_t(j) * rowRunBytes, span.data() + std::size_t(j) * rowPitch, rowRunBytes);
+      } else {
+        std::byte* dst = group;
+        for (std::int64_t j = 0; j < runsY; ++j, dst += rowRunBytes) {
+          const std::int64_t y = stored.lo.y + j;
+          const std::uint64_t node = std::uint64_t((z0 * d.y + y) * d.x + stored.lo.x);
+          stream->read(layout.offset + node * size, dst, rowRunBytes);
+        }
       }
+      brick.loadTimes().read += since(readStart);
+      const auto preStart = Clock::now();
+      if (swap) swapBytesInPlace(group, std::size_t(z1 - z0 + 1) * slabBytes / size, size);
+      pre.add(group, z0, z1);
+      brick.loadTimes().preprocess += since(preStart);
     }
   });
-
-  // Step: bring the scalars to host order.
-  const bool hostBig = std::endian::native == std::endian::big;
-  if (size > 1 && layout.bigEndian != hostBig)
-    swapBytesInPlace(brick.bytes(), std::size_t(stored.nodeCount()), size);
-  brick.updateValueRange();
+  const auto preStart = Clock::now();
+  Preprocessed result = pre.finish();
+  brick.setPreprocessed(result.range, std::move(result.bounds));
+  brick.loadTimes().preprocess += since(preStart);
   return brick;
 }
 

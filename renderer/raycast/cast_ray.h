@@ -135,7 +135,7 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
                           p.mcFirst[a] + p.mcCount[a] - 1);
       out.hit = true;
       kernel::Accumulator acc;
-      if (p.visible[kernel::macrocellIndex(p, m)])
+      if (p.distance[kernel::macrocellIndex(p, m)] == 0)
         kernel::runSegment<T, kShaded, kPreintegrated>(p, ray, mid, kIn, kOut, acc, out.samples);
       out.colour = acc.rgba();
     }
@@ -156,12 +156,12 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
                       std::clamp(int(u1) >> mcShift, p.mcFirst[1], p.mcFirst[1] + p.mcCount[1] - 1),
                       std::clamp(int(u2) >> mcShift, p.mcFirst[2], p.mcFirst[2] + p.mcCount[2] - 1)};
     const std::size_t cell = kernel::macrocellIndex(p, m);
-    if (!p.visible[cell]) {
+    const int distance = p.distance[cell];
+    if (distance != 0) {
       // Empty space. Deep in it, leap over the macrocells the distance
       // field proves empty (those within d - 1 of this one, wherever sample
       // k lies inside it); next to something visible, step out of this
       // macrocell.
-      const int distance = p.distance[cell];
       k = distance > 1 ? k + std::max<std::int64_t>(1, std::int64_t(double(distance - 1) * ray.leapPerMacrocell))
                        : kernel::macrocellExit(ray, m, k, mcShift);
       continue;

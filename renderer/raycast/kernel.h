@@ -36,8 +36,7 @@ struct KernelParams {
   float domainMax[3];  // dims - 1: positions read around a sample stay in the domain
   float invSpacing[3];  // 1 / spacing, for world-space gradients
   // Macrocells.
-  const std::uint8_t* visible = nullptr;
-  const std::uint8_t* distance = nullptr;  // MacrocellGrid::distance()
+  const std::uint8_t* distance = nullptr;  // MacrocellGrid::distance(): 0 = visible
   int mcFirst[3], mcCount[3];
   // Classification.
   const Rgba* table = nullptr;  // TransferTable or PreintegratedTable entries
@@ -342,7 +341,7 @@ inline Rgba stretch(const Rgba& c, double w) {
   return {c.r * k, c.g * k, c.b * k, float(a)};
 }
 
-// Index into p.visible of the macrocell with global index m.
+// Index into p.distance of the macrocell with global index m.
 inline std::size_t macrocellIndex(const KernelParams& p, const int* m) {
   return std::size_t(((m[2] - p.mcFirst[2]) * p.mcCount[1] + (m[1] - p.mcFirst[1])) * p.mcCount[0] +
                      (m[0] - p.mcFirst[0]));

@@ -1,99 +1,154 @@
 #include "macrocells.h"
 
 #include <algorithm>
-#include <cmath>
+#include <chrono>
 #include <limits>
+
+#include "../preprocess.h"
 
 namespace pvr::core {
 
-MacrocellGrid::MacrocellGrid(const Brick& brick) {
-  const NodeBox& own = brick.owned();
-  const NodeBox& st = brick.stored();
-  for (int a = 0; a < 3; ++a) {
-    // Cells owned run from own.lo to own.hi - 1 (at least one cell unless the
-    // grid is one node thick on this axis).
-    const std::int64_t lastCell = std::max(own.lo[a], own.hi[a] - 1);
-    first_[a] = own.lo[a] >> kShift;
-    count_[a] = (lastCell >> kShift) - first_[a] + 1;
-  }
-  const std::size_t n = std::size_t(count_.product());
-  min_.assign(n, std::numeric_limits<float>::infinity());
-  max_.assign(n, -std::numeric_limits<float>::infinity());
-  visible_.assign(n, 1);
+namespace {
 
-  dispatchScalar(brick.type(), [&](auto tag) {
-    using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
-    const T* v = brick.as<T>();
-    // Each stored node widens every macrocell whose node range
-    // [kSize*m, kSize*m + kSize] holds it: at most two per axis.
-    auto cellsOf = [&](int a, std::int64_t node, std::int64_t& m0, std::int64_t& m1) {
-      // m0 = ceil((node - kSize) / kSize), m1 = floor(node / kSize);
-      // >> floors negative numbers too.
-      m0 = std::max<std::int64_t>(first_[a], (node - 1) >> kShift);
-      m1 = std::min<std::int64_t>(first_[a] + count_[a] - 1, node >> kShift);
-    };
-    for (std::int64_t z = st.lo.z; z <= st.hi.z; ++z) {
-      std::int64_t mz0, mz1;
-      cellsOf(2, z, mz0, mz1);
-      for (std::int64_t y = st.lo.y; y <= st.hi.y; ++y) {
-        std::int64_t my0, my1;
-        cellsOf(1, y, my0, my1);
-        const T* rowp = v + brick.linearIndex({st.lo.x, y, z});
-        for (std::int64_t x = st.lo.x; x <= st.hi.x; ++x) {
-          const float val = float(rowp[x - st.lo.x]);
-          if (!std::isfinite(val)) continue;
-          std::int64_t mx0, mx1;
-          cellsOf(0, x, mx0, mx1);
-          for (std::int64_t mz = mz0; mz <= mz1; ++mz)
-            for (std::int64_t my = my0; my <= my1; ++my)
-              for (std::int64_t mx = mx0; mx <= mx1; ++mx) {
-                const std::size_t i = std::size_t(((mz - first_.z) * count_.y + (my - first_.y)) *
-                                                      count_.x + (mx - first_.x));
-                min_[i] = std::min(min_[i], val);
-                max_[i] = std::max(max_[i], val);
-              }
-        }
+constexpr int kFar = 255;  // the distance field's cap: "255 or farther"
+
+// Runs body(begin, end) over chunks of [0, n), over the pool when there is one.
+template <typename F>
+void forChunks(std::size_t n, ThreadPool* pool, F&& body) {
+  const std::size_t chunks = pool ? std::min<std::size_t>(n, std::size_t(pool->size()) * 4) : 1;
+  if (chunks <= 1) {
+    if (n > 0) body(std::size_t(0), n);
+    return;
+  }
+  pool->parallelFor(chunks, [&](std::size_t c, int) { body(n * c / chunks, n * (c + 1) / chunks); });
+}
+
+// The 1-D min-max transform of a line, in place:
+//   d(i) = min(255, min over q of max(|i - q|, f(q))).
+// Applied along x to the 0/255 visibility it gives the distance along x;
+// applied next along y and then z to the previous result it gives the 3-D
+// chessboard distance, because a cube (the chessboard ball) is the product
+// of three intervals. Each direction is one pass: going forward,
+// a(i) = min(f(i), A) where A, the best over q < i, is a(i-1) or a(i-1)+1;
+// it stays a(i-1) = v exactly when some q < i with f(q) = v lies within v
+// of i, and the latest such q is remembered per value. Positions are
+// stamped with a base that grows from line to line, so a stale entry is
+// always too far back to count and the table needs no clearing.
+//
+// A step's look-up depends on the step before, so kLanes neighbouring
+// lines go in lockstep: their chains are independent and overlap in the
+// CPU, and they share cache lines.
+class MinMaxLines {
+ public:
+  static constexpr int kLanes = 8;
+
+  // Transforms `lines` (1..kLanes) lines of n elements each: element k of
+  // line j is f[j * lineStep + k * stride].
+  void transform(std::uint8_t* f, std::ptrdiff_t lineStep, int lines, std::ptrdiff_t stride, std::int64_t n) {
+    if (base_ > kMaxBase - 2 * (n + kFar + 1)) reset();
+    forward_.resize(std::size_t(n) * kLanes);
+    sweep(n, lines, [&](int j, std::int64_t k) -> std::uint8_t& { return f[j * lineStep + k * stride]; },
+          [&](int j, std::int64_t k, int a) { forward_[std::size_t(k) * kLanes + std::size_t(j)] = std::uint8_t(a); });
+    sweep(n, lines, [&](int j, std::int64_t k) -> std::uint8_t& { return f[j * lineStep + (n - 1 - k) * stride]; },
+          [&](int j, std::int64_t k, int a) {
+            std::uint8_t& out = f[j * lineStep + (n - 1 - k) * stride];
+            out = std::uint8_t(std::min<int>(a, forward_[std::size_t(n - 1 - k) * kLanes + std::size_t(j)]));
+          });
+  }
+
+ private:
+  static constexpr std::int32_t kMaxBase = std::int32_t(1) << 30;
+
+  void reset() {
+    for (auto& lane : last_) std::fill(std::begin(lane), std::end(lane), -kMaxBase);
+    base_ = 0;
+  }
+
+  // One direction; at(j, k) is line j's k-th element in sweep order,
+  // done(j, k, a) is called after it was read with the one-sided result a.
+  template <typename At, typename Done>
+  void sweep(std::int64_t n, int lines, At&& at, Done&& done) {
+    int prev[kLanes];
+    std::fill(std::begin(prev), std::end(prev), kFar);
+    for (std::int64_t k = 0; k < n; ++k) {
+      const std::int32_t here = base_ + std::int32_t(k);
+      for (int j = 0; j < lines; ++j) {
+        const int fk = at(j, k);
+        const int p = prev[j];
+        const int a = p >= kFar ? kFar : (last_[j][p] >= here - p ? p : p + 1);
+        prev[j] = std::min(fk, a);
+        last_[j][fk] = here;
+        done(j, k, prev[j]);
       }
     }
-    return 0;
+    base_ += std::int32_t(n) + kFar + 1;
+  }
+
+  std::int32_t last_[kLanes][kFar + 1];
+  std::int32_t base_ = kMaxBase;  // forces a reset before the first line
+  std::vector<std::uint8_t> forward_;
+};
+
+}  // namespace
+
+void chessboardDistance(std::uint8_t* d, IVec3 count, ThreadPool* pool) {
+  constexpr int kLanes = MinMaxLines::kLanes;
+  const std::int64_t nx = count.x, ny = count.y, nz = count.z;
+  auto lanesFrom = [](std::int64_t i, std::int64_t end) { return int(std::min<std::int64_t>(kLanes, end - i)); };
+  // Along x: one line per (y, z), kLanes rows at a time.
+  const std::int64_t rows = ny * nz, rowGroups = (rows + kLanes - 1) / kLanes;
+  forChunks(std::size_t(rowGroups), pool, [&](std::size_t b, std::size_t e) {
+    MinMaxLines lines;
+    for (std::int64_t r = std::int64_t(b) * kLanes; r < std::min(rows, std::int64_t(e) * kLanes); r += kLanes)
+      lines.transform(d + r * nx, nx, lanesFrom(r, rows), 1, nx);
+  });
+  // Along y: one line per (x, z), kLanes neighbours in x at a time.
+  forChunks(std::size_t(nz), pool, [&](std::size_t b, std::size_t e) {
+    MinMaxLines lines;
+    for (std::int64_t z = std::int64_t(b); z < std::int64_t(e); ++z)
+      for (std::int64_t x = 0; x < nx; x += kLanes) lines.transform(d + z * nx * ny + x, 1, lanesFrom(x, nx), nx, ny);
+  });
+  // Along z: one line per (x, y).
+  forChunks(std::size_t(ny), pool, [&](std::size_t b, std::size_t e) {
+    MinMaxLines lines;
+    for (std::int64_t y = std::int64_t(b); y < std::int64_t(e); ++y)
+      for (std::int64_t x = 0; x < nx; x += kLanes) lines.transform(d + y * nx + x, 1, lanesFrom(x, nx), nx * ny, nz);
   });
 }
 
-void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty) {
-  for (std::size_t i = 0; i < visible_.size(); ++i)
-    visible_[i] = !skipEmpty || (min_[i] <= max_[i] && table.anyVisible(min_[i], max_[i]));
-  updateDistances();
+MacrocellGrid::MacrocellGrid(const Brick& brick, ThreadPool* pool) : bounds_(brick.macrocellBounds()) {
+  if (!bounds_) {
+    const auto start = std::chrono::steady_clock::now();
+    bounds_ = preprocessVoxels(brick.type(), brick.owned(), brick.stored(), brick.bytes(), pool).bounds;
+    buildSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  distance_.assign(bounds_->layout().size(), 0);  // all visible until classified
 }
 
-void MacrocellGrid::updateDistances() {
-  // Two raster passes of a chamfer transform with the 26-neighbourhood give
-  // the exact chessboard distance: forward with the neighbours already
-  // visited, backward with the others.
-  const int nx = int(count_.x), ny = int(count_.y), nz = int(count_.z);
-  distance_.assign(visible_.size(), 255);
-  auto at = [&](int x, int y, int z) -> std::uint8_t& {
-    return distance_[(std::size_t(z) * ny + y) * nx + x];
-  };
-  for (std::size_t i = 0; i < visible_.size(); ++i)
-    if (visible_[i]) distance_[i] = 0;
-  auto relax = [&](int x, int y, int z, int dirSign) {
-    std::uint8_t& d = at(x, y, z);
-    for (int dz = -1; dz <= 0; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          // Neighbours earlier in this pass's raster order.
-          if (dz == 0 && (dy > 0 || (dy == 0 && dx >= 0))) continue;
-          const int qx = x + dirSign * dx, qy = y + dirSign * dy, qz = z + dirSign * dz;
-          if (qx < 0 || qy < 0 || qz < 0 || qx >= nx || qy >= ny || qz >= nz) continue;
-          d = std::uint8_t(std::min<int>(d, at(qx, qy, qz) + 1));
-        }
-  };
-  for (int z = 0; z < nz; ++z)
-    for (int y = 0; y < ny; ++y)
-      for (int x = 0; x < nx; ++x) relax(x, y, z, 1);
-  for (int z = nz - 1; z >= 0; --z)
-    for (int y = ny - 1; y >= 0; --y)
-      for (int x = nx - 1; x >= 0; --x) relax(x, y, z, -1);
+void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty, ThreadPool* pool) {
+  const std::size_t n = distance_.size();
+  const std::size_t layer = std::size_t(count().x * count().y);
+  dispatchScalar(bounds_->type(), [&](auto tag) {
+    using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+    const T* mn = bounds_->min<T>();
+    const T* mx = bounds_->max<T>();
+    // uint8 bounds take their answer from a table of every (min, max) pair.
+    std::vector<std::uint8_t> pairVisible;
+    if constexpr (std::is_same_v<T, std::uint8_t>) {
+      pairVisible.assign(256 * 256, 0);
+      for (int lo = 0; lo < 256; ++lo)
+        for (int hi = lo; hi < 256; ++hi) pairVisible[std::size_t(lo * 256 + hi)] = table.anyVisible(lo, hi);
+    }
+    auto visible = [&](std::size_t i) -> bool {
+      if constexpr (std::is_same_v<T, std::uint8_t>) return pairVisible[std::size_t(mn[i]) * 256 + mx[i]];
+      else return mn[i] <= mx[i] && table.anyVisible(double(mn[i]), double(mx[i]));
+    };
+    forChunks(n / std::max<std::size_t>(layer, 1), pool, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b * layer; i < e * layer; ++i)
+        distance_[i] = !skipEmpty || visible(i) ? 0 : kFar;
+    });
+  });
+  if (skipEmpty) chessboardDistance(distance_.data(), count(), pool);
 }
 
 }  // namespace pvr::core

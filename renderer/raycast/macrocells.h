@@ -1,54 +1,64 @@
 // Min-max macrocells for empty-space skipping.
 //
-// The grid's cells are grouped into macrocells of kSize^3 cells, aligned to
-// the global grid (macrocell m covers cells [kSize*m, kSize*m + kSize)), so
-// a brick and the whole volume skip the same space. Each macrocell keeps the
-// finite min and max of the nodes its cells interpolate (kSize + 1 per
-// axis). A sample that rounding places in a neighbouring macrocell lies
-// within ~1e-5 voxel of the shared face, where the reconstruction is the
-// face nodes' values that both macrocells hold. Small macrocells (4^3
-// cells) keep thin visible structures from dragging whole blocks of empty
-// space into the sample loop. Classification against a
-// transfer function is one O(1) query per macrocell, cheap enough to redo on
-// every transfer-function change.
+// The bounds (macrocell_bounds.h) come with the brick when its reader or
+// updateValueRange() computed them, and are shared, not copied; otherwise
+// the grid computes them itself. A sample that rounding places in a
+// neighbouring macrocell lies within ~1e-5 voxel of the shared face, where
+// the reconstruction is the face nodes' values that both macrocells hold.
+// Small macrocells (4^3 cells) keep thin visible structures from dragging
+// whole blocks of empty space into the sample loop. Classification against
+// a transfer function is one O(1) query per macrocell and a separable
+// distance transform, cheap enough to redo on every transfer-function
+// change.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "../brick.h"
+#include "../macrocell_bounds.h"
+#include "../thread_pool.h"
 #include "../transfer.h"
 
 namespace pvr::core {
 
 class MacrocellGrid {
  public:
-  static constexpr int kShift = 2;
-  static constexpr int kSize = 1 << kShift;  // cells per macrocell edge
+  static constexpr int kShift = MacrocellLayout::kShift;
+  static constexpr int kSize = MacrocellLayout::kSize;
 
-  MacrocellGrid() = default;
-  explicit MacrocellGrid(const Brick& brick);
+  // Takes the brick's bounds, or computes them (over the pool's threads
+  // when one is given) if the brick carries none.
+  explicit MacrocellGrid(const Brick& brick, ThreadPool* pool = nullptr);
 
   // Marks each macrocell visible if the transfer function gives some value
-  // in its range a non-zero opacity; all visible when skipping is off.
-  void classify(const TransferTable& table, bool skipEmpty);
+  // in its range a non-zero opacity (all visible when skipping is off), then
+  // updates the distance field. Threaded over the pool when one is given;
+  // the result does not depend on it.
+  void classify(const TransferTable& table, bool skipEmpty, ThreadPool* pool = nullptr);
 
-  IVec3 first() const { return first_; }    // global index of the brick's first macrocell
-  IVec3 count() const { return count_; }    // macrocells per axis
-  const std::uint8_t* visible() const { return visible_.data(); }
+  IVec3 first() const { return bounds_->layout().first; }  // global index of the brick's first macrocell
+  IVec3 count() const { return bounds_->layout().count; }  // macrocells per axis
+  const MacrocellBounds& bounds() const { return *bounds_; }
   // Chessboard distance, in macrocells, from each macrocell to the nearest
-  // visible one (0 for visible macrocells, capped at 255). A ray in a
+  // visible one: 0 for a visible macrocell, capped at 255. A ray in a
   // macrocell at distance d may leap d - 1 macrocells along its major axis
   // without meeting anything visible (space leaping with a distance field).
   const std::uint8_t* distance() const { return distance_.data(); }
+  // Seconds the constructor spent computing bounds (0 when the brick had them).
+  double buildSeconds() const { return buildSeconds_; }
 
  private:
-  IVec3 first_, count_;
-  std::vector<float> min_, max_;
-  std::vector<std::uint8_t> visible_;
+  std::shared_ptr<const MacrocellBounds> bounds_;
   std::vector<std::uint8_t> distance_;
-
-  void updateDistances();
+  double buildSeconds_ = 0;
 };
+
+// The exact chessboard distance transform of `distance` (count.x fastest),
+// in place: on entry 0 marks a visible macrocell and 255 an invisible one;
+// on return each holds min(255, distance to the nearest 0). Three separable
+// passes, one per axis (see macrocells.cpp). Exposed for tests.
+void chessboardDistance(std::uint8_t* distance, IVec3 count, ThreadPool* pool = nullptr);
 
 }  // namespace pvr::core

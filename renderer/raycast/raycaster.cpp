@@ -49,13 +49,13 @@ int ghostLayers(const GridGeometry& grid, const RenderOptions& options) {
   return layers;
 }
 
-BrickRenderer::BrickRenderer(const Brick& brick) : brick_(brick), macrocells_(brick) {}
+BrickRenderer::BrickRenderer(const Brick& brick, ThreadPool* pool) : brick_(brick), macrocells_(brick, pool) {}
 
-void BrickRenderer::classify(const TransferFunctionSpec& tf, const RenderOptions& options) {
+void BrickRenderer::classify(const TransferFunctionSpec& tf, const RenderOptions& options, ThreadPool* pool) {
   table_ = TransferTable(tf, options.step);
   preintegrated_.reset();
   if (options.preintegrated) preintegrated_ = std::make_unique<PreintegratedTable>(tf, options.step);
-  macrocells_.classify(table_, options.skipEmpty);
+  macrocells_.classify(table_, options.skipEmpty, pool);
   classifiedStep_ = options.step;
 }
 
@@ -103,7 +103,6 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
     p.mcFirst[a] = int(macrocells_.first()[a]);
     p.mcCount[a] = int(macrocells_.count()[a]);
   }
-  p.visible = macrocells_.visible();
   p.distance = macrocells_.distance();
   if (preintegrated_) {
     p.table = preintegrated_->entries();

@@ -46,12 +46,15 @@ struct RenderStats {
 
 class BrickRenderer {
  public:
-  // Builds the macrocell grid; the brick must outlive the renderer.
-  explicit BrickRenderer(const Brick& brick);
+  // Builds the macrocell grid from the brick's bounds, or computes them
+  // (over the pool's threads when one is given) if it carries none; the
+  // brick must outlive the renderer.
+  explicit BrickRenderer(const Brick& brick, ThreadPool* pool = nullptr);
 
-  // (Re)builds the classification tables and macrocell visibility. Cheap;
-  // call on every transfer-function, step or skipping change.
-  void classify(const TransferFunctionSpec& tf, const RenderOptions& options);
+  // (Re)builds the classification tables, macrocell visibility and distance
+  // field, over the pool's threads when one is given. Cheap; call on every
+  // transfer-function, step or skipping change.
+  void classify(const TransferFunctionSpec& tf, const RenderOptions& options, ThreadPool* pool = nullptr);
 
   // `options` must match the last classify() in step and pre-integration.
   // Renders the brick's screen rectangle, or only its part inside `region`
@@ -62,6 +65,9 @@ class BrickRenderer {
 
   const Brick& brick() const { return brick_; }
   const MacrocellGrid& macrocells() const { return macrocells_; }
+  // Seconds the constructor spent computing macrocell bounds: 0 when the
+  // brick carried them (its loadTimes().preprocess counted them then).
+  double preprocessSeconds() const { return macrocells_.buildSeconds(); }
 
  private:
   const Brick& brick_;

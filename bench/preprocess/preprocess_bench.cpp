@@ -1,0 +1,218 @@
+// Preprocessing speed: value range + macrocell bounds, classification with
+// the distance field, and content counts, per scalar type, on 1 and 2
+// threads, beside the pre-issue-11 algorithm (old_preprocess.h) on the same
+// brick, whose results the new ones must equal. Prints a table and writes
+// bench/results/preprocess/preprocess.{csv,txt}.
+//
+//   pvr-bench-preprocess [--size N] [--file VOLUME]... [--out DIR]
+//
+// Defaults: a synthetic N = 512 cube per type and the int16 CT head of
+// ../shared/data (of a file, the brick rank 0 of 8 would read: the first
+// octant plus a ghost layer); DIR = bench/results/preprocess of this tree.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "brick.h"
+#include "decompose/content.h"
+#include "io/volume_io.h"
+#include "old_preprocess.h"
+#include "raycast/macrocells.h"
+#include "thread_pool.h"
+#include "transfer.h"
+
+namespace {
+
+using namespace pvr::core;
+using pvr::bench::OldMacrocells;
+using Clock = std::chrono::steady_clock;
+
+double seconds(const std::function<void()>& f, int repeats) {
+  double best = 1e300;
+  for (int r = 0; r < repeats; ++r) {
+    const auto t = Clock::now();
+    f();
+    best = std::min(best, std::chrono::duration<double>(Clock::now() - t).count());
+  }
+  return best;
+}
+
+// A smooth field over the type's range with empty regions (so the distance
+// field has work), float with a NaN every 1009 voxels.
+Brick syntheticBrick(ScalarType type, std::int64_t n) {
+  GridGeometry grid;
+  grid.dims = {n, n, n};
+  grid.spacing = {1, 1, 1};
+  Brick b(grid, type, grid.allNodes(), grid.allNodes());
+  dispatchScalar(type, [&](auto tag) {
+    using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+    const double lo = std::is_floating_point_v<T> ? 0.0 : double(std::numeric_limits<T>::lowest());
+    const double hi = std::is_floating_point_v<T> ? 1.0 : double(std::numeric_limits<T>::max());
+    T* v = b.as<T>();
+    std::size_t i = 0;
+    for (std::int64_t z = 0; z < n; ++z)
+      for (std::int64_t y = 0; y < n; ++y) {
+        const double yz = std::sin(0.071 * double(y)) * std::sin(0.033 * double(z));
+        for (std::int64_t x = 0; x < n; ++x, ++i) {
+          const double f = 0.5 + 0.5 * std::sin(0.05 * double(x)) * yz;
+          v[i] = T(lo + f * (hi - lo));
+          if constexpr (std::is_floating_point_v<T>)
+            if (i % 1009 == 0) v[i] = std::numeric_limits<float>::quiet_NaN();
+        }
+      }
+  });
+  return b;
+}
+
+// Shows the upper 40% of the brick's value range.
+TransferTable upperTable(const ValueRange& r) {
+  TransferFunctionSpec tf;
+  const double w = r.max - r.min;
+  tf.points = {{r.min, 0, 0, 0, 0}, {r.min + 0.6 * w, 0, 0, 0, 0}, {r.min + 0.61 * w, 1, 1, 1, 0.3}, {r.max, 1, 1, 1, 0.6}};
+  tf.unitDistance = 1;
+  return TransferTable(tf, 0.5);
+}
+
+struct Row {
+  std::string brick, type, impl;
+  int threads = 1;
+  std::uint64_t voxels = 0;
+  double bounds = 0, classify = 0, content = 0;
+  bool agrees = true;
+  double total() const { return bounds + classify + content; }
+  double perCore() const { return double(voxels) / total() / threads; }
+};
+
+// Old and new on one brick; new on 1 and 2 threads. `b` arrives without bounds.
+std::vector<Row> measure(Brick& b, const std::string& name) {
+  std::vector<Row> rows;
+  const std::uint64_t voxels = std::uint64_t(b.stored().nodeCount());
+  const Brick& cb = b;
+
+  // The baseline, once (it is slow), and its results for the agreement check.
+  Row old{name, std::string(scalarName(b.type())), "old", 1, voxels};
+  OldMacrocells om;
+  ValueRange oldRange;
+  old.bounds = seconds([&] { oldRange = pvr::bench::oldValueRange(cb); om = pvr::bench::oldMacrocellBounds(cb); }, 1);
+  const TransferTable table = upperTable(oldRange);
+  old.classify = seconds([&] { pvr::bench::oldClassify(om, table); }, 1);
+  ContentGrid oldContent;
+  old.content = seconds([&] { oldContent = pvr::bench::oldCountContent(cb, table); }, 1);
+  rows.push_back(old);
+
+  for (int threads : {1, 2}) {
+    ThreadPool pool(threads);
+    ThreadPool* p = threads > 1 ? &pool : nullptr;
+    Row r{name, old.type, "new", threads, voxels};
+    r.bounds = seconds([&] { b.updateValueRange(p); }, 3);
+    MacrocellGrid grid(cb);
+    r.classify = seconds([&] { grid.classify(table, true, p); }, 3);
+    ContentGrid content;
+    r.content = seconds([&] { content = countContent(cb, table, {8, 8, 8}, p); }, 3);
+
+    // The same results as the baseline.
+    const ValueRange& nr = cb.valueRange();
+    r.agrees = nr.min == oldRange.min && nr.max == oldRange.max && nr.nonFinite == oldRange.nonFinite &&
+               content.counts == oldContent.counts &&
+               std::equal(om.distance.begin(), om.distance.end(), grid.distance());
+    const MacrocellBounds& nb = grid.bounds();
+    for (std::size_t i = 0; i < om.min.size() && r.agrees; ++i) {
+      const bool oldEmpty = om.min[i] > om.max[i], newEmpty = nb.minAt(i) > nb.maxAt(i);
+      r.agrees = oldEmpty == newEmpty && (oldEmpty || (nb.minAt(i) == om.min[i] && nb.maxAt(i) == om.max[i]));
+    }
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+std::string loadAverage() {
+  std::ifstream in("/proc/loadavg");
+  std::string one, five, fifteen;
+  in >> one >> five >> fifteen;
+  return one + " " + five + " " + fifteen;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::int64_t size = 512;
+  std::vector<std::string> files;
+  std::string out = std::string(PVR_SOURCE_DIR) + "/bench/results/preprocess";
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--size" && i + 1 < argc) size = std::stoll(argv[++i]);
+    else if (a == "--file" && i + 1 < argc) files.push_back(argv[++i]);
+    else if (a == "--out" && i + 1 < argc) out = argv[++i];
+    else {
+      std::cerr << "usage: pvr-bench-preprocess [--size N] [--file VOLUME]... [--out DIR]\n";
+      return 2;
+    }
+  }
+  if (files.empty()) files.push_back(std::string(PVR_SOURCE_DIR) + "/../shared/data/ct_head_cranium/ct_head_cranium.json");
+
+  std::ostringstream text;
+  const std::string loadBefore = loadAverage();
+  std::vector<Row> rows;
+  for (ScalarType type : {ScalarType::kUInt8, ScalarType::kUInt16, ScalarType::kInt16, ScalarType::kFloat32}) {
+    Brick b = syntheticBrick(type, size);
+    const std::string name = "synthetic " + std::to_string(size) + "^3";
+    for (const Row& r : measure(b, name)) rows.push_back(r);
+  }
+  for (const std::string& path : files) {
+    // The brick rank 0 of 8 reads: the first octant and one ghost layer.
+    const auto source = openVolumeFile(path);
+    const IVec3 d = source->grid().dims;
+    const NodeBox owned{{0, 0, 0}, {d.x / 2, d.y / 2, d.z / 2}};
+    Brick b = source->readBox(owned, owned.grown(1).intersect(source->grid().allNodes()));
+    text << "fused read of " << toString(b.stored()) << " from " << source->describe() << ": "
+         << b.loadTimes().read << " s in I/O calls, "
+         << b.loadTimes().preprocess << " s preprocessing ("
+         << double(b.stored().nodeCount()) / std::max(b.loadTimes().preprocess, 1e-9) / 1e9
+         << " G voxels/s, page cache warm or cold as it happened)\n";
+    b.bytes();  // drop the reader's bounds so that the new pass computes them again
+    for (const Row& r : measure(b, std::filesystem::path(path).stem().string() + " octant")) rows.push_back(r);
+  }
+
+  // Step: the table, the CSV and the text file.
+  text << "bounds = value range + macrocell min/max; classify = visibility + distance field;\n"
+          "content = content counts in 8^3 blocks; Mvox/s/core = voxels / total / threads;\n"
+          "best of 3 runs for new, 1 for old (single-threaded: it has no threads); agrees = new\n"
+          "range, bounds, distances and counts equal old's.\n";
+  char line[256];
+  std::snprintf(line, sizeof line, "%-22s %-8s %-4s %3s %10s %10s %10s %10s %14s %7s\n", "brick", "type", "impl",
+                "thr", "bounds s", "classify s", "content s", "total s", "Mvox/s/core", "agrees");
+  text << line;
+  for (const Row& r : rows) {
+    std::snprintf(line, sizeof line, "%-22s %-8s %-4s %3d %10.4f %10.4f %10.4f %10.4f %14.0f %7s\n", r.brick.c_str(),
+                  r.type.c_str(), r.impl.c_str(), r.threads, r.bounds, r.classify, r.content, r.total(),
+                  r.perCore() / 1e6, r.impl == "old" ? "-" : (r.agrees ? "yes" : "NO"));
+    text << line;
+  }
+  text << "load average (1, 5, 15 min) before: " << loadBefore << ", after: " << loadAverage()
+       << " on " << std::thread::hardware_concurrency() << " hardware threads; a load above ~1 means"
+       << " other work shared the cores and the figures are low.\n";
+  std::cout << text.str();
+
+  std::filesystem::create_directories(out);
+  std::ofstream csv(out + "/preprocess.csv");
+  csv << "brick,type,impl,threads,voxels,bounds_s,classify_s,content_s,total_s,voxels_per_s_per_core,agrees\n";
+  for (const Row& r : rows)
+    csv << r.brick << "," << r.type << "," << r.impl << "," << r.threads << "," << r.voxels << "," << r.bounds
+        << "," << r.classify << "," << r.content << "," << r.total() << "," << r.perCore() << ","
+        << (r.impl == "old" ? "" : (r.agrees ? "yes" : "no")) << "\n";
+  std::ofstream(out + "/preprocess.txt") << text.str();
+  bool ok = true;
+  for (const Row& r : rows) ok &= r.agrees;
+  return ok ? 0 : 1;
+}

@@ -1,0 +1,57 @@
+// Preprocessing a brick's voxels: its value range and macrocell bounds in
+// one pass, slab by slab.
+//
+// The pass walks node slabs (one z each). Within a slab, the rows of each
+// macrocell row's node range (kSize + 1 rows) are reduced element by
+// element, which the compiler vectorises, and the reduced row is then
+// reduced along x once per macrocell: the separable min/max. The slab's
+// 2-D bounds then widen the (at most two) macrocell layers whose node range
+// holds the slab. A slab's few rows stay in cache while all of this
+// happens, so a reader can hand each slab over right after it lands and
+// the data is touched once (raw_reader.cpp). Float data skips NaN and Inf
+// in both range and bounds, and counts them.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "brick.h"
+#include "macrocell_bounds.h"
+
+namespace pvr::core {
+
+class ThreadPool;
+
+struct Preprocessed {
+  ValueRange range;
+  std::shared_ptr<MacrocellBounds> bounds;
+};
+
+// Takes a brick's node slabs one or a few at a time, in any order, each
+// once; single-threaded. For readers that fill a brick slab by slab.
+class SlabPreprocessor {
+ public:
+  SlabPreprocessor(ScalarType type, const NodeBox& owned, const NodeBox& stored);
+  ~SlabPreprocessor();
+  SlabPreprocessor(const SlabPreprocessor&) = delete;
+  SlabPreprocessor& operator=(const SlabPreprocessor&) = delete;
+
+  // Folds in slabs z0..z1 (inclusive, inside the stored box) whose voxels,
+  // in host byte order, start at `voxels`: stored.extent(0) per row,
+  // stored.extent(1) rows per slab.
+  void add(const std::byte* voxels, std::int64_t z0, std::int64_t z1);
+  // The result, once every stored slab has been added.
+  Preprocessed finish();
+
+  struct Impl;  // one per scalar type, in preprocess.cpp
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// The whole stored box at once, over the pool's threads when one is given
+// (chunks of macrocell layers); the result does not depend on the threads.
+Preprocessed preprocessVoxels(ScalarType type, const NodeBox& owned, const NodeBox& stored,
+                              const std::byte* voxels, ThreadPool* pool = nullptr);
+
+}  // namespace pvr::core
