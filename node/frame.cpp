@@ -109,8 +109,8 @@ PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& optio
     prepared.camera.emplace(result.scene.camera, result.scene.image.width, result.scene.image.height);
     core::ThreadPool pool(options.threads);
     const auto prepStart = std::chrono::steady_clock::now();
-    core::BrickRenderer renderer(prepared.bricks.brick);
-    renderer.classify(result.scene.transfer, renderOptions);
+    core::BrickRenderer renderer(prepared.bricks.brick, &pool);
+    renderer.classify(result.scene.transfer, renderOptions, &pool);
     report.prep = loaded.preprocess + secondsSince(prepStart);
     const auto start = std::chrono::steady_clock::now();
     prepared.partial = renderer.render(*prepared.camera, renderOptions, pool);
