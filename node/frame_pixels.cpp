@@ -3,7 +3,7 @@
 #include <cstring>
 
 #include "error.h"
-#include "image_io.h"
+#include "image_srgb.h"
 
 namespace pvr::node {
 

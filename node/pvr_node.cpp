@@ -31,7 +31,7 @@
 #include "catalog_listing.h"
 #include "frame.h"
 #include "hosts.h"
-#include "image_io.h"
+#include "image_output.h"
 #include "mpi_communicator.h"
 #include "report.h"
 #include "server_mode.h"
@@ -147,7 +147,7 @@ int run(const Args& args, const std::vector<std::string>& hosts, comm::Communica
   comm::runAgreed(comm, [&] {
     if (comm.rank() != 0) return;
     const auto writeStart = std::chrono::steady_clock::now();
-    core::writeImage(result.image, result.scene.image.background, args.output);
+    node::writeImageFile(result.image, result.scene.image.background, args.output);
     node::OutputTimes output;
     output.write = std::chrono::duration<double>(std::chrono::steady_clock::now() - writeStart).count();
     output.wall = node::processAgeSeconds();

@@ -1,4 +1,7 @@
 // Writing and reading frames: EXR for measurement, PNG for people.
+// Library pvr_image_io (OpenImageIO): tools, tests and benches link it;
+// pvr-node loads it only to write a file (node/image_output.h), so its
+// ranks do not carry OpenImageIO's ~130 MB of libraries beside their bricks.
 //
 // EXR holds the image as rendered: linear, premultiplied RGBA float32, the
 // full frame (transparent outside the image's rect), NOT composited over the
@@ -14,17 +17,9 @@
 #include <vector>
 
 #include "image.h"
+#include "image_srgb.h"
 
 namespace pvr::core {
-
-// Linear value in [0, 1] (clamped; NaN -> 0) to an 8-bit sRGB code value,
-// rounded to nearest: IEC 61966-2-1 curve (12.92 x below 0.0031308, else
-// 1.055 x^(1/2.4) - 0.055).
-std::uint8_t linearToSrgb8(double linear);
-
-// The full frame of `image` composited over `background` (straight RGBA,
-// premultiplied here) as 8-bit sRGB, straight-alpha RGBA, rows top to bottom.
-std::vector<std::uint8_t> toSrgbRgba8(const Image& image, const std::array<double, 4>& background);
 
 void writeExr(const Image& image, const std::string& path);
 void writePng(const Image& image, const std::array<double, 4>& background, const std::string& path);

@@ -8,7 +8,9 @@
 #     the session handler;
 #   - renderer/ includes nothing of protocol/, node/, pvrd/ or pvrsh/, and
 #     protocol/ nothing of the others;
-#   - pvrsh/ and pvrd/ include nothing of renderer/ or node/.
+#   - pvrsh/ and pvrd/ include nothing of renderer/ or node/;
+#   - OpenImageIO only in renderer/image_io.cpp: pvr-node loads the image
+#     writer module instead of carrying its libraries on every rank.
 set -u
 root=${1:-$(dirname "$0")/..}
 cd "$root" || exit 2
@@ -43,6 +45,8 @@ check "protocol/ includes nothing of renderer/ or node/" \
   "#include *\"($(headers_of renderer | sed 's/|comm[^|]*//g')|$(headers_of node))\"" '^$' protocol
 check "pvrd/ and pvrsh/ include nothing of renderer/ or node/" \
   "#include *\"($(headers_of node)|raycast/[^\"]*|scene\\.h|brick\\.h|communicator\\.h|strategy\\.h)\"" '^$' "pvrd pvrsh"
+check "OpenImageIO only in renderer/image_io.cpp" '#include *<OpenImageIO/' '^renderer/image_io\.cpp$'
+check "node/ includes no image file code (node/image_output.h loads it)" '#include *"image_io\.h"' '^$' node
 # ctest splits a discovered Catch2 name at ';' and then runs no test at all,
 # which passes: a name with ';' is a test that can never fail.
 bad=$(grep -rnE 'TEST_CASE\("[^"]*;' tests 2>/dev/null || true)

@@ -3,7 +3,7 @@
 # start-up costs ~0.5 s per job), and pvr-node --batch against pvr-render.
 if(TARGET pvr_comm_mpi AND TARGET pvr-node)
   add_executable(pvr_node_mpi_driver mpi_driver.cpp)
-  target_link_libraries(pvr_node_mpi_driver PRIVATE pvr_node_frame pvr_comm_mpi ZLIB::ZLIB)
+  target_link_libraries(pvr_node_mpi_driver PRIVATE pvr_node_frame pvr_image_io pvr_comm_mpi ZLIB::ZLIB)
   set(PVR_MPI_ENV OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1)
   set(PVR_MPIRUN ${MPIEXEC_EXECUTABLE} --oversubscribe --bind-to none)
   set(PVR_MPI_SCRATCH ${CMAKE_CURRENT_BINARY_DIR}/scratch)
