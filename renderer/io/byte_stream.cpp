@@ -39,6 +39,11 @@ std::size_t FileStream::readSome(std::uint64_t offset, std::byte* dst, std::size
   return done;
 }
 
+void FileStream::willNeed(std::uint64_t offset, std::size_t n) {
+  // Only a hint: a kernel that refuses it costs speed, not data.
+  (void)::posix_fadvise(fd_, off_t(offset), off_t(n), POSIX_FADV_WILLNEED);
+}
+
 void FileStream::read(std::uint64_t offset, std::byte* dst, std::size_t n) {
   const std::size_t got = readSome(offset, dst, n);
   // The size was checked when the volume was opened; a short read here means

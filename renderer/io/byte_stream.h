@@ -19,6 +19,12 @@ class ByteStream {
   // Offsets never decrease from one call to the next. Throws pvr::Error
   // naming the file when the bytes are not there.
   virtual void read(std::uint64_t offset, std::byte* dst, std::size_t n) = 0;
+  // A hint that bytes [offset, offset + n) will be read soon: a file starts
+  // reading them in the background, so a reader whose runs are not one
+  // sequential stream (a brick's slabs, with other ranks' rows between
+  // them) keeps the disk busy instead of waiting on each run in turn.
+  // A forward-only stream decodes in order anyway: it ignores the hint.
+  virtual void willNeed(std::uint64_t /*offset*/, std::size_t /*n*/) {}
 };
 
 // A file opened read-only for positioned reads; closes it on destruction.
@@ -32,6 +38,7 @@ class FileStream final : public ByteStream {
 
   // Reads exactly n bytes at offset; throws if the file ends first.
   void read(std::uint64_t offset, std::byte* dst, std::size_t n) override;
+  void willNeed(std::uint64_t offset, std::size_t n) override;
   // Reads up to n bytes at offset; returns how many (fewer only at the end of the file).
   std::size_t readSome(std::uint64_t offset, std::byte* dst, std::size_t n);
   const std::string& where() const { return where_; }

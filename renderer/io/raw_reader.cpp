@@ -122,10 +122,27 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
   const bool swap = size > 1 && layout.bigEndian != (std::endian::native == std::endian::big);
   SlabPreprocessor pre(type, owned, stored);
   std::byte* voxels = brick.bytes();
+  // The file bytes of the group of slabs starting at z0: from its first
+  // run to the end of its last.
+  auto groupOffset = [&](std::int64_t z0) {
+    return layout.offset + std::uint64_t((z0 * d.y + stored.lo.y) * d.x + stored.lo.x) * size;
+  };
+  auto groupBytes = [&](std::int64_t z0) {
+    if (wholeSlabs) return std::size_t(std::min(stored.hi.z, z0 + slabsPerGroup - 1) - z0 + 1) * slabBytes;
+    return std::size_t(e.y - 1) * rowPitch + std::size_t(e.x) * size;
+  };
+  // Groups announced ahead of the one being read (ByteStream::willNeed):
+  // enough bytes in flight to keep a disk's queue full.
+  constexpr std::size_t kReadAheadBytes = std::size_t(128) << 20;
+  const std::int64_t groupsAhead =
+      std::max<std::int64_t>(1, std::int64_t(kReadAheadBytes / groupBytes(stored.lo.z)));
   withHeaderNamed(layout, [&] {
     std::unique_ptr<ByteStream> stream = openStream(layout);
+    std::int64_t announced = stored.lo.z;  // first group not yet announced
     for (std::int64_t z0 = stored.lo.z; z0 <= stored.hi.z; z0 += slabsPerGroup) {
       const std::int64_t z1 = std::min(stored.hi.z, z0 + slabsPerGroup - 1);
+      for (; announced <= stored.hi.z && announced < z0 + groupsAhead * slabsPerGroup; announced += slabsPerGroup)
+        stream->willNeed(groupOffset(announced), groupBytes(announced));
       std::byte* group = voxels + std::size_t(z0 - stored.lo.z) * slabBytes;
       const auto readStart = Clock::now();
       if (wholeSlabs) {
