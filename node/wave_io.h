@@ -40,11 +40,13 @@ struct CameraArgs {
 CameraArgs cameraArgs(const core::CameraSpec& camera);
 core::CameraSpec cameraSpec(const CameraArgs& camera);  // never automatic
 
-// One frame of a wave: its number in the request and its camera.
+// One frame of a wave: its number in the request, its camera and the time
+// step it shows.
 struct FrameView {
   std::uint32_t number = 0;
   CameraArgs camera;
-  static auto fields(auto& self) { return std::tie(self.number, self.camera); }
+  std::int32_t timestep = 0;
+  static auto fields(auto& self) { return std::tie(self.number, self.camera, self.timestep); }
 };
 
 // The part of `image` inside `rect` (an image whose rect is the intersection).
