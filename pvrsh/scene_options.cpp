@@ -1,6 +1,7 @@
 #include "scene_options.h"
 
 #include <algorithm>
+#include <climits>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -170,6 +171,15 @@ void setRuntimeName(Apply& a, const char* key, std::string_view listKey) {
   a.scene({{"runtime", {{key, a.value}}}});
 }
 
+// -timestep K: the scene's "timestep" (docs/scene.md), the 0-based step of
+// a time series the session shows; the server checks it against the
+// dataset's steps.
+void setTimestep(Apply& a) { a.scene({{"timestep", parseInteger(a.option, a.value, 0, INT32_MAX)}}); }
+
+// -cachemem MB: runtime.cachemem, the brick cache's budget per render rank
+// (docs/runtime.md); the server checks the upper bound.
+void setCacheMemory(Apply& a) { a.scene({{"runtime", {{"cachemem", parseInteger(a.option, a.value, 0, INT32_MAX)}}}}); }
+
 struct OptionRow {
   const char* name;  // first field: Tcl_GetIndexFromObjStruct reads it
   void (*apply)(Apply&);
@@ -202,6 +212,8 @@ const OptionRow kOptions[] = {
     {"-light", [](Apply& a) { a.scene({{"shading", {{"light_direction", a.vec3()}}}}); }},
     {"-strategy", [](Apply& a) { setRuntimeName(a, "strategy", "strategies"); }},
     {"-decomposition", [](Apply& a) { setRuntimeName(a, "decomposition", "decompositions"); }},
+    {"-timestep", setTimestep},
+    {"-cachemem", setCacheMemory},
     {nullptr, nullptr}};
 
 void remember(Settings& s, const std::string& option, const std::string& value) {
