@@ -45,7 +45,8 @@ void BrickCache::setBudget(std::uint64_t bytes) {
   stopReadAhead();
   std::lock_guard lock(mutex_);
   budget_ = bytes;
-  makeRoom(0, {}, true);
+  // Least recently used first; a step on screen stays alive with its owner.
+  while (stats_.bytesHeld > budget_) evictLocked(recent_.back());
 }
 
 void BrickCache::insert(const std::shared_ptr<ReadyBrick>& ready) {
@@ -142,12 +143,16 @@ bool BrickCache::makeRoom(std::uint64_t bytes, const std::vector<int>& keep, boo
         break;
       }
     if (victim < 0) return false;
-    stats_.bytesHeld -= held_[victim]->bytes();
-    --stats_.stepsHeld;
-    held_.erase(victim);
-    recent_.remove(victim);
+    evictLocked(victim);
   }
   return true;
+}
+
+void BrickCache::evictLocked(int step) {
+  stats_.bytesHeld -= held_[step]->bytes();
+  --stats_.stepsHeld;
+  held_.erase(step);
+  recent_.remove(step);
 }
 
 void BrickCache::holdLocked(const std::shared_ptr<ReadyBrick>& ready) {

@@ -89,6 +89,7 @@ class BrickCache {
   bool makeRoom(std::uint64_t bytes, const std::vector<int>& keep, bool evictWanted);
   void holdLocked(const std::shared_ptr<ReadyBrick>& ready);  // under mutex_
   void touchLocked(int step);
+  void evictLocked(int step);  // under mutex_
 
   Reader reader_;
   std::uint64_t budget_ = 0;
