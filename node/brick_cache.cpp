@@ -59,7 +59,9 @@ void BrickCache::insert(const std::shared_ptr<ReadyBrick>& ready) {
 std::shared_ptr<ReadyBrick> BrickCache::take(int step) {
   {
     std::unique_lock lock(mutex_);
-    done_.wait(lock, [&] { return reading_ != step; });
+    // A step the background thread is reading, or will read next, is worth
+    // the wait: it comes no later than a read of our own.
+    done_.wait(lock, [&] { return reading_ != step && !contains(queued_, step); });
     if (auto it = held_.find(step); it != held_.end()) {
       ++stats_.hits;
       touchLocked(step);
@@ -77,34 +79,40 @@ std::shared_ptr<ReadyBrick> BrickCache::take(int step) {
 }
 
 void BrickCache::readAhead(std::vector<int> steps) {
-  stopReadAhead();
-  // Each step once, in order.
-  std::vector<int> unique;
-  for (int s : steps)
-    if (!contains(unique, s)) unique.push_back(s);
-  steps = std::move(unique);
   {
     std::lock_guard lock(mutex_);
-    wanted_ = steps;
-    const bool allHeld = std::all_of(steps.begin(), steps.end(), [&](int s) { return held_.count(s) > 0; });
-    if (!reader_ || budget_ == 0 || allHeld) return;
+    // Each step once, in order; the background thread reads those not held.
+    wanted_.clear();
+    queued_.clear();
+    for (int s : steps) {
+      if (contains(wanted_, s)) continue;
+      wanted_.push_back(s);
+      if (!held_.count(s) && s != reading_) queued_.push_back(s);
+    }
+    if (!reader_ || budget_ == 0) queued_.clear();
+    // A running thread takes the new list when its current read ends: the
+    // read in progress is not interrupted (it is most likely the next one).
+    if (queued_.empty() || active_) return;
+    active_ = true;
     stop_ = false;
   }
-  worker_ = std::thread([this, steps = std::move(steps)] { readAheadLoop(steps); });
+  if (worker_.joinable()) worker_.join();  // a thread that has finished
+  worker_ = std::thread([this] { readAheadLoop(); });
 }
 
-void BrickCache::readAheadLoop(std::vector<int> steps) {
-  for (std::size_t i = 0; i < steps.size(); ++i) {
-    const int step = steps[i];
-    {
-      std::lock_guard lock(mutex_);
-      if (stop_) return;
-      if (held_.count(step)) continue;
-      // Room at the cost of steps not wanted, or of steps wanted after this one.
-      const std::vector<int> keep(steps.begin(), steps.begin() + std::ptrdiff_t(i + 1));
-      if (stepBytes_ > budget_ || !makeRoom(stepBytes_, keep, false)) return;  // every step's brick is alike
-      reading_ = step;
-    }
+void BrickCache::readAheadLoop() {
+  std::unique_lock lock(mutex_);
+  while (!stop_ && !queued_.empty()) {
+    const int step = queued_.front();
+    queued_.erase(queued_.begin());
+    if (held_.count(step)) continue;
+    // Room at the cost of steps not wanted, or of steps wanted after this
+    // one; every step's brick is alike.
+    const auto upTo = std::find(wanted_.begin(), wanted_.end(), step);
+    const std::vector<int> keep(wanted_.begin(), upTo == wanted_.end() ? upTo : upTo + 1);
+    if (stepBytes_ > budget_ || !makeRoom(stepBytes_, keep, false)) break;
+    reading_ = step;
+    lock.unlock();
     const auto start = std::chrono::steady_clock::now();
     std::shared_ptr<ReadyBrick> ready;
     try {
@@ -112,13 +120,16 @@ void BrickCache::readAheadLoop(std::vector<int> steps) {
     } catch (...) {
       // The step's failure is reported when it is needed and read on demand.
     }
-    std::lock_guard lock(mutex_);
+    lock.lock();
     stats_.readAheadSeconds += secondsSince(start);
     if (ready && makeRoom(ready->bytes(), {}, false)) holdLocked(ready);
     reading_ = -1;
     done_.notify_all();
-    if (!ready) return;
+    if (!ready) break;
   }
+  queued_.clear();  // what is left is read on demand
+  active_ = false;
+  done_.notify_all();
 }
 
 void BrickCache::stopReadAhead() {
@@ -127,6 +138,8 @@ void BrickCache::stopReadAhead() {
     stop_ = true;
   }
   if (worker_.joinable()) worker_.join();
+  std::lock_guard lock(mutex_);
+  stop_ = false;
 }
 
 bool BrickCache::makeRoom(std::uint64_t bytes, const std::vector<int>& keep, bool evictWanted) {

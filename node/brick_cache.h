@@ -75,15 +75,16 @@ class BrickCache {
   // read to end), or read now on this thread (a miss). Throws what the
   // reader throws.
   std::shared_ptr<ReadyBrick> take(int step);
-  // Starts reading `steps` (in the order they will be shown) on the
-  // background thread, as many as the budget holds. Replaces any earlier list.
+  // Reads `steps` (in the order they will be shown) on the background
+  // thread, as many as the budget holds. Replaces any earlier list; a read
+  // in progress goes on.
   void readAhead(std::vector<int> steps);
 
   CacheStats stats() const;
 
  private:
   void stopReadAhead();  // waits for the background thread
-  void readAheadLoop(std::vector<int> steps);
+  void readAheadLoop();  // the background thread: reads queued_ in order
   // Under mutex_: makes room for `bytes`, evicting steps not in `keep`
   // (and never one somebody else holds). False if it cannot.
   bool makeRoom(std::uint64_t bytes, const std::vector<int>& keep, bool evictWanted);
@@ -100,7 +101,9 @@ class BrickCache {
   std::vector<int> wanted_;  // the upcoming steps of the last readAhead
   std::uint64_t stepBytes_ = 0;  // one step's brick bytes, once one was read
   int reading_ = -1;  // the step the background thread is reading; -1: none
-  bool stop_ = false;
+  std::vector<int> queued_;  // the steps it will read after that, in order
+  bool stop_ = false;    // the background thread ends after its current read
+  bool active_ = false;  // the background thread is running
   std::thread worker_;
   CacheStats stats_;
 };
