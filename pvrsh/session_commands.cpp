@@ -244,6 +244,7 @@ proto::RenderTimeSteps parseTimeRange(Session& s, const std::string& range) {
     t.last = std::uint32_t(parseInteger("-last", steps.substr(comma + 1), 0, INT32_MAX));
   } else {
     // The server's status says how many steps the dataset has.
+    s.requireOpen("render time");
     const auto count = s.serverNames("timesteps");
     if (!count || count->size() != 1)
       argsError("TIME", "render time " + range +
@@ -271,7 +272,6 @@ int renderCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
       return TCL_ERROR;
     }
     const std::string range = str(objv[3]);
-    s.requireOpen("render time");
     const proto::RenderTimeSteps t = parseTimeRange(s, range);
     s.render(t, t.frameCount(), "time " + range);
     Tcl_SetObjResult(interp, Tcl_NewWideIntObj(t.frameCount()));
