@@ -21,6 +21,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <nlohmann/json.hpp>
@@ -301,8 +302,8 @@ core::Image dumped(const Job& job, std::uint32_t request, int frame) {
   return image;
 }
 
-// A sequence's frames: in order, the last FINAL, each equal to the reference.
-void checkSequence(Job& job, std::uint32_t request, int frames, int steps, const Reference& ref) {
+// A sequence's frames: in order, the last FINAL, frame k equal to want(k).
+void checkFrames(Job& job, std::uint32_t request, int frames, const std::function<core::Image(int)>& want) {
   for (int k = 0; k < frames; ++k) {
     auto d = job.receive();
     REQUIRE(d);
@@ -312,10 +313,15 @@ void checkSequence(Job& job, std::uint32_t request, int frames, int steps, const
     CHECK(f.frameNumber == std::uint32_t(k));
     CHECK(d->info.final() == (k == frames - 1));
     CHECK(f.timing.render > 0);
-    const double diff = core::maxAbsDifference(dumped(job, request, k), ref.frame(k, steps));
+    const double diff = core::maxAbsDifference(dumped(job, request, k), want(k));
     INFO("frame " << k);
     CHECK(diff <= 1e-5);
   }
+}
+
+// A rotation of `steps` steps per turn: frame k is the reference turned k steps.
+void checkSequence(Job& job, std::uint32_t request, int frames, int steps, const Reference& ref) {
+  checkFrames(job, request, frames, [&](int k) { return ref.frame(k, steps); });
 }
 
 // "list status" as a map.
@@ -469,18 +475,9 @@ TEST_CASE_METHOD(Fixture, "clusters, groups and a compositing cluster all render
 // Frames of RenderTimeSteps k = 0.., each the in-process rendering of its
 // step's own volume file at the session's view.
 void checkTimeSequence(Job& job, std::uint32_t request, const std::vector<int>& steps) {
-  for (std::size_t k = 0; k < steps.size(); ++k) {
-    auto d = job.receive();
-    REQUIRE(d);
-    if (const auto* e = std::get_if<proto::ErrorMessage>(&d->message)) FAIL("frame " << k << ": " << e->text);
-    const auto& f = std::get<proto::ImageFrame>(d->message);
-    CHECK(d->info.requestId == request);
-    CHECK(f.frameNumber == std::uint32_t(k));
-    CHECK(d->info.final() == (k + 1 == steps.size()));
-    const Reference ref(nlohmann::json::object(), stepFile(steps[k]));
-    INFO("frame " << k << ", step " << steps[k]);
-    CHECK(core::maxAbsDifference(dumped(job, request, int(k)), ref.frame(0, 1)) <= 1e-5);
-  }
+  checkFrames(job, request, int(steps.size()), [&](int k) {
+    return Reference(nlohmann::json::object(), stepFile(steps[std::size_t(k)])).frame(0, 1);
+  });
 }
 
 // A session of the job's ranks showing the series.
