@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 
+#include "cache_cluster.h"
 #include "decompose/content.h"
 #include "scene_volume.h"
 #include "transfer.h"
@@ -131,7 +132,8 @@ Reload openScene(NodeState& state, const std::string& sceneJson) {
 }
 
 void dropData(NodeState& state) {
-  state.cache.clear();  // first: its reader refers to the source and the tree
+  state.served.clear();  // first: their readers refer to the source
+  state.cache.clear();
   state.current.reset();
   state.tree.reset();
 }
@@ -141,10 +143,16 @@ void loadBricks(NodeState& state) {
 }
 
 void loadStep(NodeState& state) {
-  collectFailure(state, [&] { showStep(state, state.scene.volume.timestep); });
+  collectFailure(state, [&] {
+    const int step = state.scene.volume.timestep;
+    showStep(state, step);
+    if (const ClusterPlan* me = state.myCluster(); me && me->role == proto::ClusterRole::kCache)
+      for (int c : me->serves) serveStep(state, c, step, {});
+  });
 }
 
 void distributeData(NodeState& state) {
+  prepareCacheRank(state);
   if (!state.renders() || !state.source) return;
   distributeStep(state, state.scene.volume.timestep);
 }
@@ -156,6 +164,10 @@ void showStep(NodeState& state, int step) {
   if (!state.tree || !state.source->canReadPartially()) {
     comm::runAgreed(cluster, [&] { checkStep(*state.source, step); });
     distributeStep(state, step);  // keeps the decomposition's kind, not its tree
+    return;
+  }
+  if (servedByCacheCluster(state, *state.myCluster())) {
+    putOnScreen(state, receiveStep(state, step), true);
     return;
   }
   std::shared_ptr<ReadyBrick> ready;

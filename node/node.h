@@ -89,6 +89,13 @@ struct NodeState {
   std::shared_ptr<ReadyBrick> current;
   // Steps held and read ahead for this rank (brick_cache.h); dropped with the tree.
   BrickCache cache;
+  // Cache ranks (cache_cluster.h): per render rank served, by (render
+  // cluster, index in it), its steps and the step it shows.
+  struct ServedRank {
+    std::unique_ptr<BrickCache> cache;
+    int shown = -1;
+  };
+  std::map<std::pair<int, int>, ServedRank> served;
   // Time not yet charged to a frame (FrameTiming): reading bricks,
   // preprocessing them (value range, macrocells, classification), and the
   // rest of a (re)distribution (decomposition, scatter).

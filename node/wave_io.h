@@ -24,6 +24,7 @@ constexpr int kTreeTag = 25002;     // composite rank -> composite rank
 constexpr int kBandTag = 25003;     // finished band -> collector
 constexpr int kPingTag = 25004;     // calibration
 constexpr int kOrderTag = 25005;    // render cluster root -> composite cluster: visibility order
+constexpr int kStepTag = 25006;     // cache rank -> render rank: a time step's brick (cache_cluster.h)
 
 // Sub-images between ranks: the smaller of the sparse codes, per image.
 constexpr core::ImageCodec kSubImageCodec = core::ImageCodec::kAuto;

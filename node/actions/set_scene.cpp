@@ -24,6 +24,7 @@ void SetScene::run(NodeState& state, const SetScene& args) {
     }
     state.matchPoolToSettings();
     state.cache.setBudget(cacheBudgetBytes(state.settings));
+    for (auto& [key, served] : state.served) served.cache->setBudget(cacheBudgetBytes(state.settings) / state.served.size());
     classify(state);
   });
   if (reload == Reload::kAll) loadBricks(state);

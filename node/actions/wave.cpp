@@ -13,6 +13,7 @@
 // dispatcher's one world agreement then reports the lowest rank's.
 #include <chrono>
 
+#include "../cache_cluster.h"
 #include "../data.h"
 #include "../wave_collect.h"
 #include "../wave_composite.h"
@@ -58,6 +59,18 @@ void renderMyFrame(NodeState& state, const Wave& args, std::optional<comm::Failu
   }
 }
 
+// Cache ranks: each render cluster I serve gets its frame's step, and its
+// group's next steps are read ahead (cache_cluster.h).
+void serveMyClusters(NodeState& state, const Wave& args) {
+  const ClusterPlan* me = state.myCluster();
+  if (!me || me->role != proto::ClusterRole::kCache) return;
+  for (int c : me->serves) {
+    const int group = state.layout.clusters[std::size_t(c)].group;
+    if (group < int(state.wave.size()))
+      serveStep(state, c, state.wave[std::size_t(group)].timestep, myUpcoming(args.upcoming, group, state.layout.groups));
+  }
+}
+
 }  // namespace
 
 void Wave::run(NodeState& state, const Wave& args) {
@@ -70,6 +83,7 @@ void Wave::run(NodeState& state, const Wave& args) {
     state.wave.push_back(std::move(w));
   }
   std::optional<comm::Failure> failure;
+  serveMyClusters(state, args);
   renderMyFrame(state, args, failure);
   compositeWave(state, failure);
   collectWave(state, args.request, args.lastFrame, failure);

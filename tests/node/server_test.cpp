@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -531,6 +532,52 @@ TEST_CASE_METHOD(Fixture, "render time: each frame equals its step's volume; the
   id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 2, 12});
   const Reference step2(nlohmann::json::object(), stepFile(2));
   checkSequence(job, id, 3, 12, step2);
+  CHECK(job.close());
+}
+
+TEST_CASE_METHOD(Fixture, "a caching cluster renders the same frames; its render ranks read no step after the first", "[series]") {
+  if (!seriesFormatRegistered()) return;
+  // Rank 0 the dedicated master, ranks 1-2 render, rank 3 caches for them.
+  Job job(4, {});
+  job.send(proto::SessionOpen{4, {{ClusterRole::kRender, 2, 0}, {ClusterRole::kCache, 1, 0}}, ""});
+  const auto ready = job.expect<proto::SessionReady>();
+  REQUIRE(ready.clusters.size() == 3);
+  CHECK(ready.clusters[2].role == ClusterRole::kCache);
+  job.send(proto::SetScene{kSeries, kScene});
+  job.expect<proto::Ok>();
+  // performance cache by role: {hits, misses} of the cache rank, misses of the render ranks.
+  const auto counts = [&] {
+    job.send(proto::PerformanceRequest{proto::PerformanceQuery::kCache, proto::kAllClusters});
+    const auto reply = nlohmann::json::parse(job.expect<proto::PerformanceReply>().json);
+    std::uint64_t hits = 0, misses = 0, renderMisses = 0;
+    for (const auto& r : reply["ranks"]) {
+      if (r["role"] == "cache") {
+        hits += r["hits"].get<std::uint64_t>();
+        misses += r["misses"].get<std::uint64_t>();
+      } else {
+        renderMisses += r["misses"].get<std::uint64_t>();
+      }
+    }
+    return std::array<std::uint64_t, 3>{hits, misses, renderMisses};
+  };
+  auto id = job.send(proto::RenderTimeSteps{0, 3, 1});
+  checkTimeSequence(job, id, {0, 1, 2, 3});
+  const auto first = counts();
+  CHECK(first[0] + first[1] == 3 * 2);  // steps 1-3 for two render ranks
+  CHECK(first[2] == 0);
+  // Every step the cache rank sent is still held: a second pass hits.
+  id = job.send(proto::RenderTimeSteps{1, 3, 2});
+  checkTimeSequence(job, id, {1, 3});
+  const auto second = counts();
+  CHECK(second[0] == first[0] + 2 * 2);
+  CHECK(second[1] == first[1]);
+  CHECK(second[2] == 0);
+  // set -timestep goes through the cache rank too; a rotation keeps the step.
+  job.send(proto::SetScene{"", R"({"timestep": 2})"});
+  job.expect<proto::Ok>();
+  id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 1, 12});
+  checkSequence(job, id, 2, 12, Reference(nlohmann::json::object(), stepFile(2)));
+  CHECK(counts()[2] == 0);
   CHECK(job.close());
 }
 
