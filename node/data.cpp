@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 
+#include "cache_cluster.h"
 #include "decompose/content.h"
 #include "scene_volume.h"
 #include "transfer.h"
@@ -14,20 +15,95 @@ namespace pvr::node {
 
 namespace {
 
-double secondsSince(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
+using Clock = std::chrono::steady_clock;
 
-// What identifies a volume: equal keys, equal data.
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// What identifies a volume: equal keys, equal data. The timestep is not
+// part of it: another step of the same dataset keeps the headers open.
 std::string volumeKeyOf(const core::VolumeSpec& v) {
   nlohmann::json key = {{"file", v.file}, {"procedural", v.procedural}, {"dims", {v.dims.x, v.dims.y, v.dims.z}}};
   if (v.spacing) key["spacing"] = {v.spacing->x, v.spacing->y, v.spacing->z};
   return key.dump();
 }
 
+// Reads this rank's brick of any step of the open volume, for the cache:
+// the boxes of the current tree, captured, so it never touches the state.
+BrickCache::Reader stepReader(const NodeState& state) {
+  if (!state.source->canReadPartially()) return nullptr;  // a step needs rank 0's read and scatter
+  const int rank = state.clusterComm->rank();
+  return [source = state.source.get(), owned = state.tree->ownedBox(rank),
+          stored = core::storedBox(*state.tree, rank, state.ghost)](int step) {
+    return source->step(step).readBox(owned, stored);
+  };
+}
+
+// Puts `ready` on screen and classifies it; charges what it cost to the
+// next frame when it was read for it (not read ahead).
+void putOnScreen(NodeState& state, std::shared_ptr<ReadyBrick> ready, bool readNow) {
+  state.current = std::move(ready);
+  if (readNow) {
+    state.pendingRead += state.current->readSeconds;
+    state.pendingPreprocess += state.current->preprocessSeconds;
+  }
+  const auto start = Clock::now();
+  classify(state);
+  state.pendingPreprocess += secondsSince(start);
+}
+
+// Collective over my render cluster: a new tree and this rank's brick of
+// `step`; the cache starts over with it.
+void distributeStep(NodeState& state, int step) {
+  const auto start = Clock::now();
+  const double charged = state.pendingRead + state.pendingPreprocess;
+  dropData(state);
+  comm::SubCommunicator& cluster = *state.clusterComm;
+  // A failure agreed on the cluster already names the world rank it came from.
+  Distribution d =
+      distributeBricks(state.source->step(step), state.scene, state.settings.decomposition, state.ghost, cluster);
+  state.tree = std::move(d.tree);
+  putOnScreen(state, makeReady(std::move(d.brick), step), true);
+  state.cache.reset(stepReader(state));
+  state.cache.insert(state.current);
+  // The rest of the distribution: decomposition, scatter, waiting.
+  state.pendingDist += secondsSince(start) - (state.pendingRead + state.pendingPreprocess - charged);
+}
+
+// Collective over the world, after a phase that may have failed on this
+// rank: every rank learns the data's value range (of the bricks on
+// screen), then a rank that failed throws.
+void agreeOnValueRange(NodeState& state, const std::optional<comm::Failure>& failure) {
+  // Max of (-min, max) over the ranks that hold a brick.
+  constexpr double kNone = -std::numeric_limits<double>::infinity();
+  std::vector<double> range{kNone, kNone};
+  if (state.current) range = {-state.current->brick.valueRange().min, state.current->brick.valueRange().max};
+  state.world.allReduceMax(range);
+  state.valueRange.reset();
+  if (range[1] > kNone) state.valueRange = std::array<double, 2>{-range[0], range[1]};
+  if (failure) throw comm::FailureError(*failure);
+}
+
+void collectFailure(NodeState& state, const std::function<void()>& phase) {
+  std::optional<comm::Failure> failure;
+  try {
+    phase();
+  } catch (...) {
+    failure = comm::failureOf(std::current_exception(), state.world.rank());
+  }
+  agreeOnValueRange(state, failure);
+}
+
+// The one rule for a step number (core::checkTimestep), for a step the
+// session shows other than the scene's own (render time).
+void checkStep(const NodeState& state, int step) {
+  core::VolumeSpec spec = state.scene.volume;
+  spec.timestep = step;
+  core::checkTimestep(spec, *state.source);
+}
+
 }  // namespace
 
-bool openScene(NodeState& state, const std::string& sceneJson) {
+Reload openScene(NodeState& state, const std::string& sceneJson) {
   core::Scene scene = core::parseScene(nlohmann::json::parse(sceneJson), state.dataDir);
   const std::string key = volumeKeyOf(scene.volume);
   const bool changed = key != state.volumeKey || !state.source;
@@ -37,6 +113,7 @@ bool openScene(NodeState& state, const std::string& sceneJson) {
     source = core::openSceneVolume(scene.volume);
     grid = source.get();
   }
+  core::checkTimestep(scene.volume, *grid);
   core::resolveDefaults(scene, grid->grid());
   const core::RenderOptions options = core::renderOptionsFor(scene);
   const int ghost = core::ghostLayers(grid->grid(), options);
@@ -46,57 +123,71 @@ bool openScene(NodeState& state, const std::string& sceneJson) {
     state.source = std::move(source);
     state.volumeKey = key;
   }
+  const bool stepChanged = scene.volume.timestep != state.scene.volume.timestep;
   state.scene = scene;
   state.renderOptions = options;
   const bool ghostChanged = ghost != state.ghost;
   state.ghost = ghost;
-  return changed || (ghostChanged && state.brick.byteSize() > 0);
+  if (changed || (ghostChanged && state.current)) return Reload::kAll;
+  return stepChanged ? Reload::kStep : Reload::kNone;
 }
 
 void dropData(NodeState& state) {
-  state.renderer.reset();
-  state.brick = core::Brick();
+  state.served.clear();  // first: their readers refer to the source
+  state.cache.clear();
+  state.current.reset();
   state.tree.reset();
 }
 
 void loadBricks(NodeState& state) {
-  std::optional<comm::Failure> failure;
-  try {
-    distributeData(state);
-  } catch (...) {
-    failure = comm::failureOf(std::current_exception(), state.world.rank());
-  }
-  // Max of (-min, max) over the ranks that hold a brick.
-  constexpr double kNone = -std::numeric_limits<double>::infinity();
-  std::vector<double> range{kNone, kNone};
-  if (state.renderer) range = {-state.brick.valueRange().min, state.brick.valueRange().max};
-  state.world.allReduceMax(range);
-  state.valueRange.reset();
-  if (range[1] > kNone) state.valueRange = std::array<double, 2>{-range[0], range[1]};
-  if (failure) throw comm::FailureError(*failure);
+  collectFailure(state, [&] { distributeData(state); });
+}
+
+void loadStep(NodeState& state) {
+  collectFailure(state, [&] {
+    const int step = state.scene.volume.timestep;
+    showStep(state, step);
+    if (const ClusterPlan* me = state.myCluster(); me && me->role == proto::ClusterRole::kCache)
+      for (int c : me->serves) serveStep(state, c, step, {});
+  });
 }
 
 void distributeData(NodeState& state) {
+  prepareCacheRank(state);
   if (!state.renders() || !state.source) return;
-  const auto start = std::chrono::steady_clock::now();
-  dropData(state);
+  distributeStep(state, state.scene.volume.timestep);
+}
+
+void showStep(NodeState& state, int step) {
+  if (!state.renders() || !state.source) return;
+  if (state.current && state.current->step == step) return;
   comm::SubCommunicator& cluster = *state.clusterComm;
-  // A failure agreed on the cluster already names the world rank it came from.
-  Distribution d = distributeBricks(*state.source, state.scene, state.settings.decomposition, state.ghost, cluster);
-  state.tree = std::move(d.tree);
-  state.brick = std::move(d.brick);
-  state.renderer = std::make_unique<core::BrickRenderer>(state.brick);
-  classify(state);
-  state.pendingDist += secondsSince(start);
+  if (!state.tree || !state.source->canReadPartially()) {
+    comm::runAgreed(cluster, [&] { checkStep(state, step); });
+    distributeStep(state, step);  // keeps the decomposition's kind, not its tree
+    return;
+  }
+  if (servedByCacheCluster(state, *state.myCluster())) {
+    putOnScreen(state, receiveStep(state, step), true);
+    return;
+  }
+  std::shared_ptr<ReadyBrick> ready;
+  std::uint64_t misses = 0;
+  comm::runAgreed(cluster, [&] {
+    checkStep(state, step);
+    misses = state.cache.stats().misses;
+    ready = state.cache.take(step);
+  });
+  putOnScreen(state, std::move(ready), state.cache.stats().misses > misses);
 }
 
 void classify(NodeState& state) {
-  if (state.renderer) state.renderer->classify(state.scene.transfer, state.renderOptions);
+  if (state.current) state.current->renderer->classify(state.scene.transfer, state.renderOptions);
 }
 
 void rebalanceIfNeeded(NodeState& state) {
   if (!state.renders() || !state.tree || state.settings.decomposition != Decomposition::kBalanced) return;
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   comm::SubCommunicator& cluster = *state.clusterComm;
 
   // What the new transfer function shows in each brick.
@@ -104,7 +195,7 @@ void rebalanceIfNeeded(NodeState& state) {
   std::uint64_t mine = 0;
   comm::runAgreed(cluster, [&] {
     const core::TransferTable table(state.scene.transfer, state.scene.sampling.step);
-    content = core::countContent(state.brick, table);
+    content = core::countContent(state.current->brick, table);
     mine = core::totalContent(content);
   });
   cluster.allReduceSum(content.counts);
@@ -118,26 +209,31 @@ void rebalanceIfNeeded(NodeState& state) {
   if (!(mean > 0) || worst / mean <= state.settings.rebalanceThreshold) return;
 
   // Every rank of the cluster builds the same balanced tree and reads its
-  // new brick (or takes its share of a scatter).
+  // new brick of the step on screen (or takes its share of a scatter).
   std::optional<core::KdTree> tree;
   comm::runAgreed(cluster, [&] {
     tree = core::KdTree::buildBalanced(state.source->grid(), cluster.size(), kSplitAxisRule, content);
   });
+  const int step = state.current->step;
   if (state.source->canReadPartially()) {
-    state.renderer.reset();
-    state.brick = core::Brick();
+    const double charged = state.pendingRead + state.pendingPreprocess;
+    dropData(state);
+    std::shared_ptr<ReadyBrick> ready;
     comm::runAgreed(cluster, [&] {
       const int r = cluster.rank();
-      state.brick = state.source->readBox(tree->ownedBox(r), core::storedBox(*tree, r, state.ghost));
+      ready = makeReady(state.source->step(step).readBox(tree->ownedBox(r), core::storedBox(*tree, r, state.ghost)),
+                        step);
     });
     state.tree = std::move(tree);
+    putOnScreen(state, std::move(ready), true);
+    state.cache.reset(stepReader(state));
+    state.cache.insert(state.current);
+    state.pendingDist += secondsSince(start) - (state.pendingRead + state.pendingPreprocess - charged);
   } else {
-    distributeData(state);  // balanced from scratch, rank 0 of the cluster scattering
+    state.pendingDist += secondsSince(start);
+    distributeStep(state, step);  // balanced from scratch, rank 0 of the cluster scattering
   }
-  state.renderer = std::make_unique<core::BrickRenderer>(state.brick);
-  classify(state);
   ++state.rebalances;
-  state.pendingDist += secondsSince(start);
 }
 
 }  // namespace pvr::node

@@ -11,11 +11,20 @@
 
 namespace pvr::node {
 
+// What a new scene asks of the bricks.
+enum class Reload {
+  kNone,  // re-classify at most
+  kStep,  // show another time step of the same volume (same tree)
+  kAll,   // a new volume or new ghost layers: distribute again
+};
+
 // Local: parses the scene document `sceneJson` (validated by the master,
 // dataset path resolved) and opens its volume if it differs from the one
-// open; resolves the scene. Changes nothing when it throws. Returns true
-// when the bricks must be read again (new volume, or new ghost layers).
-bool openScene(NodeState& state, const std::string& sceneJson);
+// open (the volume's key leaves out the timestep: a new step re-reads
+// bricks, not headers); checks the timestep against the dataset's steps;
+// resolves the scene. Changes nothing when it throws.
+Reload openScene(NodeState& state, const std::string& sceneJson);
+
 
 // Collective over the world: render clusters read their bricks (dropping
 // the old ones; distributeData), then every rank learns the data's value
@@ -23,8 +32,20 @@ bool openScene(NodeState& state, const std::string& sceneJson);
 // then throws the cluster's failure.
 void loadBricks(NodeState& state);
 
-// Collective over each render cluster: its ranks read their bricks.
+// Collective over each render cluster: its ranks read their bricks of the
+// scene's timestep (a new tree; the brick cache starts over).
 void distributeData(NodeState& state);
+
+// Collective over the world: render clusters show the scene's timestep
+// (showStep), then every rank learns its value range, as loadBricks.
+void loadStep(NodeState& state);
+
+// Collective over my render cluster (no-op elsewhere): makes `step` the
+// brick on screen, from the cache, read on demand, or by a distribution
+// when the format cannot read a box alone. Read and preprocessing time of a
+// step not read ahead go to pendingRead / pendingPreprocess. Every rank of
+// the cluster throws the first failure.
+void showStep(NodeState& state, int step);
 
 // Collective: render clusters with a content-balanced decomposition
 // measure how even the new transfer function leaves their bricks and

@@ -18,6 +18,7 @@ std::string roleName(proto::ClusterRole role) {
     case proto::ClusterRole::kRender: return "render";
     case proto::ClusterRole::kComposite: return "composite";
     case proto::ClusterRole::kCollector: return "collector";
+    case proto::ClusterRole::kCache: return "cache";
   }
   return "unknown";
 }
@@ -95,10 +96,16 @@ Layout makeLayout(const std::vector<proto::ClusterSpec>& specsIn, int worldSize)
   layout.groups = int(groupIndex.size());
   for (int g = 0; g < layout.groups; ++g) {
     const std::vector<int> members = layout.renderClustersOf(g);
-    std::vector<int> compositors;
-    for (std::size_t c = 0; c < layout.clusters.size(); ++c)
-      if (layout.clusters[c].role == proto::ClusterRole::kComposite && layout.clusters[c].groupId == layout.clusters[std::size_t(members[0])].groupId)
-        compositors.push_back(int(c));
+    // The composite and cache clusters of the group's id.
+    const auto ofGroup = [&](proto::ClusterRole role) {
+      std::vector<int> out;
+      for (std::size_t c = 0; c < layout.clusters.size(); ++c)
+        if (layout.clusters[c].role == role && layout.clusters[c].groupId == layout.clusters[std::size_t(members[0])].groupId)
+          out.push_back(int(c));
+      return out;
+    };
+    const std::vector<int> compositors = ofGroup(proto::ClusterRole::kComposite);
+    const std::vector<int> caches = ofGroup(proto::ClusterRole::kCache);
     for (std::size_t b = 0; b < members.size(); ++b) {
       ClusterPlan& r = layout.clusters[std::size_t(members[b])];
       r.band = int(b);
@@ -107,11 +114,15 @@ Layout makeLayout(const std::vector<proto::ClusterSpec>& specsIn, int worldSize)
         r.compositor = compositors[b % compositors.size()];
         layout.clusters[std::size_t(r.compositor)].serves.push_back(members[b]);
       }
+      if (!caches.empty()) {
+        r.cacheCluster = caches[b % caches.size()];
+        layout.clusters[std::size_t(r.cacheCluster)].serves.push_back(members[b]);
+      }
     }
   }
   for (const auto& c : layout.clusters)
-    if (c.role == proto::ClusterRole::kComposite && c.serves.empty())
-      bad("composite cluster of group " + std::to_string(c.groupId) + " has no render cluster to serve");
+    if ((c.role == proto::ClusterRole::kComposite || c.role == proto::ClusterRole::kCache) && c.serves.empty())
+      bad(roleName(c.role) + " cluster of group " + std::to_string(c.groupId) + " has no render cluster to serve");
   return layout;
 }
 

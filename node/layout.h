@@ -16,6 +16,9 @@
 //   - a composite cluster composites for the render clusters of its own
 //     group (render cluster j of the group goes to composite cluster
 //     j mod C); a group without one composites on its rendering ranks.
+//   - a cache cluster reads time steps for the render clusters of its own
+//     group the same way (render cluster j to cache cluster j mod M); a
+//     group without one reads on its rendering ranks (cache_cluster.h).
 #pragma once
 
 #include <string>
@@ -31,9 +34,9 @@ struct ClusterPlan {
   std::uint32_t groupId = 0;  // as the client named it
   std::vector<int> ranks;     // world ranks
   // Render clusters: the group's index (0..G-1), band b of B, and the
-  // composite cluster serving it (-1: composites itself).
-  int group = -1, band = 0, bands = 1, compositor = -1;
-  // Composite clusters: the render clusters it serves, in band order.
+  // composite and cache clusters serving it (-1: does it itself).
+  int group = -1, band = 0, bands = 1, compositor = -1, cacheCluster = -1;
+  // Composite and cache clusters: the render clusters it serves, in band order.
   std::vector<int> serves;
 };
 

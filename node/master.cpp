@@ -13,6 +13,10 @@ namespace {
 
 using proto::ErrorCode;
 
+// How many frames per group a wave names for reading ahead: more than a
+// cache holds is no use, and the list travels with every wave.
+constexpr int kReadAheadFrames = 32;
+
 // Requests the master answers between the waves of a sequence.
 bool answeredAtOnce(const proto::Message& m) {
   return std::holds_alternative<proto::StatusRequest>(m) || std::holds_alternative<proto::PerformanceRequest>(m) ||
@@ -82,19 +86,42 @@ void Master::on(const proto::StatusRequest&, std::uint32_t id) {
 void Master::on(const proto::RenderFrame&, std::uint32_t id) {
   requireDataset(state_);
   const core::CameraSpec camera = state_.scene.camera;
-  renderSequence(1, [&](int) { return camera; }, id);
+  const int step = state_.scene.volume.timestep;
+  renderSequence(1, [&](int) { return camera; }, [&](int) { return step; }, id);
 }
 
+// A rotation shows the session's time step.
 void Master::on(const proto::RenderRotation& m, std::uint32_t id) {
   const Rotation rotation(state_.scene.camera, m);
   requireDataset(state_);
-  renderSequence(rotation.frames(), [&](int k) { return rotation.camera(k); }, id);
+  const int step = state_.scene.volume.timestep;
+  renderSequence(rotation.frames(), [&](int k) { return rotation.camera(k); }, [&](int) { return step; }, id);
+}
+
+// Frame k shows step first + k * stride at the session's view. The
+// session's time step stays what the scene says (set -timestep): a time
+// request changes only what its own frames show.
+void Master::on(const proto::RenderTimeSteps& m, std::uint32_t id) {
+  requireDataset(state_);
+  const int steps = state_.source->steps();
+  if (m.last >= std::uint32_t(steps))
+    throw Error(pvr::ErrorCode::kInvalidArgument,
+                "render time " + std::to_string(m.first) + "," + std::to_string(m.last) + ": step " +
+                    std::to_string(m.last) + " is past the last step " + std::to_string(steps - 1) + " of '" +
+                    state_.source->describe() + "'");
+  const core::CameraSpec camera = state_.scene.camera;
+  renderSequence(int(m.frameCount()), [&](int) { return camera; },
+                 [&](int k) { return int(m.first + std::uint32_t(k) * m.stride); }, id);
 }
 
 void Master::on(const proto::PerformanceRequest& p, std::uint32_t id) {
   const std::int32_t cluster = p.cluster == proto::kAllClusters ? -1 : std::int32_t(p.cluster);
-  const auto failure = p.query == proto::PerformanceQuery::kMemory ? invoke(state_, actions::ReportMemory{cluster})
-                                                                    : invoke(state_, actions::CompLatency{cluster});
+  std::optional<comm::Failure> failure;
+  switch (p.query) {
+    case proto::PerformanceQuery::kMemory: failure = invoke(state_, actions::ReportMemory{cluster}); break;
+    case proto::PerformanceQuery::kCompositing: failure = invoke(state_, actions::CompLatency{cluster}); break;
+    case proto::PerformanceQuery::kCache: failure = invoke(state_, actions::ReportCache{cluster}); break;
+  }
   if (failure) return sendError(wireError(*failure, state_.hosts), id);
   send(proto::PerformanceReply{p.query, state_.reply.dump()}, id);
 }
@@ -112,7 +139,8 @@ void Master::on(const M&, std::uint32_t id) {
   send(proto::ErrorMessage{ErrorCode::kUnsupported, std::string(M::kWire.name) + " is not served by pvr-node"}, id);
 }
 
-void Master::renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf, std::uint32_t id) {
+void Master::renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf,
+                            const std::function<int(int)>& stepOf, std::uint32_t id) {
   running_ = id;
   cancelled_ = false;
   state_.sendFrame = [&](proto::ImageFrame&& f, bool final) {
@@ -125,7 +153,9 @@ void Master::renderSequence(int count, const std::function<core::CameraSpec(int)
     wave.request = id;
     wave.lastFrame = std::uint32_t(count - 1);
     for (int k = first; k < std::min(count, first + groups); ++k)
-      wave.frames.push_back({std::uint32_t(k), cameraArgs(cameraOf(k))});
+      wave.frames.push_back({std::uint32_t(k), cameraArgs(cameraOf(k)), stepOf(k)});
+    for (int k = first + groups; k < std::min(count, first + groups + kReadAheadFrames * groups); ++k)
+      wave.upcoming.push_back(stepOf(k));
     if (auto f = invoke(state_, wave)) {
       sendError(wireError(*f, state_.hosts), id);
       break;

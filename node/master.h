@@ -37,6 +37,7 @@ class Master {
   void on(const proto::StatusRequest& m, std::uint32_t id);
   void on(const proto::RenderFrame& m, std::uint32_t id);
   void on(const proto::RenderRotation& m, std::uint32_t id);
+  void on(const proto::RenderTimeSteps& m, std::uint32_t id);
   void on(const proto::PerformanceRequest& m, std::uint32_t id);
   void on(const proto::Cancel& m, std::uint32_t id);
   void on(const proto::Close& m, std::uint32_t id);
@@ -44,9 +45,12 @@ class Master {
   void on(const M& m, std::uint32_t id);
 
   void layout(const std::vector<proto::ClusterSpec>& clusters, std::uint32_t id);
-  // Renders frames 0 .. count - 1, frame k seen by cameraOf(k), in waves of
-  // one frame per group; the request's frames go out in order, the last FINAL.
-  void renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf, std::uint32_t id);
+  // Renders frames 0 .. count - 1, frame k seen by cameraOf(k) at time
+  // step stepOf(k), in waves of one frame per group; the request's frames
+  // go out in order, the last FINAL. Each wave names the steps of the
+  // frames after it, for the render ranks to read ahead.
+  void renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf,
+                      const std::function<int(int)>& stepOf, std::uint32_t id);
 
   NodeState& state_;
   PvrdLink& link_;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "brick.h"
+#include "brick_cache.h"
 #include "command_channel.h"
 #include "communicator.h"
 #include "decompose/kd_tree.h"
@@ -37,6 +38,7 @@ namespace pvr::node {
 struct WaveFrame {
   std::uint32_t number = 0;  // position in the request
   core::CameraSpec camera;
+  int timestep = 0;     // the time step it shows
   core::Image partial;  // render ranks: this rank's brick, cut to its band
   double rend = 0, comp = 0, comm = 0;  // this rank's seconds on the frame
 };
@@ -82,8 +84,18 @@ struct NodeState {
   core::RenderOptions renderOptions;
   int ghost = 0;
   std::optional<core::KdTree> tree;  // over my cluster's ranks
-  core::Brick brick;
-  std::unique_ptr<core::BrickRenderer> renderer;
+  // The brick of the step on screen (scene.volume.timestep, or the step
+  // of the frame a time request renders), ready to render; null without data.
+  std::shared_ptr<ReadyBrick> current;
+  // Steps held and read ahead for this rank (brick_cache.h); dropped with the tree.
+  BrickCache cache;
+  // Cache ranks (cache_cluster.h): per render rank served, by (render
+  // cluster, index in it), its steps and the step it shows.
+  struct ServedRank {
+    std::unique_ptr<BrickCache> cache;
+    int shown = -1;
+  };
+  std::map<std::pair<int, int>, ServedRank> served;
   // Time not yet charged to a frame (FrameTiming): reading bricks,
   // preprocessing them (value range, macrocells, classification), and the
   // rest of a (re)distribution (decomposition, scatter).

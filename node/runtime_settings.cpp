@@ -10,6 +10,9 @@ namespace pvr::node {
 
 namespace {
 
+// 1 TiB per rank: more is a typo, not a machine.
+constexpr std::int64_t kMaxCacheMegabytes = std::int64_t(1) << 20;
+
 [[noreturn]] void bad(const std::string& key, const std::string& what) {
   throw Error(ErrorCode::kInvalidArgument, "runtime." + key + ": " + what);
 }
@@ -70,8 +73,13 @@ RuntimeSettings settingsFrom(const nlohmann::json& j) {
       if (!value.is_number_integer() || value.get<std::int64_t>() < 1 || value.get<std::int64_t>() > 256)
         bad(key, "must be an integer in 1..256, got " + value.dump());
       s.threads = value.get<std::int32_t>();
+    } else if (key == "cachemem") {
+      if (!value.is_number_integer() || value.get<std::int64_t>() < 0 || value.get<std::int64_t>() > kMaxCacheMegabytes)
+        bad(key, "must be an integer number of MB in 0.." + std::to_string(kMaxCacheMegabytes) + ", got " + value.dump());
+      s.cacheMegabytes = value.get<std::int32_t>();
     } else {
-      bad(key, "unknown key (known: strategy, decomposition, rebalance_threshold, pixels, compression, threads)");
+      bad(key,
+          "unknown key (known: strategy, decomposition, rebalance_threshold, pixels, compression, threads, cachemem)");
     }
   }
   return s;

@@ -21,9 +21,14 @@ struct RuntimeSettings {
   proto::PixelFormat format = proto::PixelFormat::kRgba8;
   proto::Compression compression = proto::Compression::kZlib;
   std::int32_t threads = 1;  // render threads per rank
+  // Per render rank, MiB of time steps' bricks the brick cache may hold
+  // (brick_cache.h). 256: a few steps of a big series per rank, and a
+  // small share of a node's memory even at 8 ranks on one host.
+  std::int32_t cacheMegabytes = kDefaultCacheMegabytes;
+  static constexpr std::int32_t kDefaultCacheMegabytes = 256;
   static auto fields(auto& self) {
     return std::tie(self.strategy, self.decomposition, self.rebalanceThreshold, self.format, self.compression,
-                    self.threads);
+                    self.threads, self.cacheMegabytes);
   }
   bool operator==(const RuntimeSettings&) const = default;
 };
@@ -33,5 +38,10 @@ struct RuntimeSettings {
 // unknown key, a wrong type, an unknown strategy (with the registered
 // ones), decomposition, pixel format or compression.
 RuntimeSettings settingsFrom(const nlohmann::json& runtime);
+
+// settings.cacheMegabytes in bytes (MiB of 2^20 bytes).
+constexpr std::uint64_t cacheBudgetBytes(const RuntimeSettings& settings) {
+  return std::uint64_t(settings.cacheMegabytes) << 20;
+}
 
 }  // namespace pvr::node

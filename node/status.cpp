@@ -2,7 +2,10 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <charconv>
+#include <cstdio>
+#include <optional>
 #include <initializer_list>
 #include <string>
 #include <string_view>
@@ -69,6 +72,57 @@ void addDataset(const NodeState& state, std::vector<proto::KeyValue>& out) {
   out.push_back({"transfer_function", points});
 }
 
+// Megabytes (2^20 bytes) with one decimal: "8.4".
+std::string megabytes(std::uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f", double(bytes) / double(1 << 20));
+  return text;
+}
+
+// The bytes of the largest brick one rank of the master's render cluster
+// holds for one step (owned nodes plus ghosts): what the cache holds per step.
+std::uint64_t oneStepBytes(const NodeState& state) {
+  const core::GridGeometry& grid = state.source->grid();
+  std::optional<core::KdTree> tree = state.tree;
+  if (!tree) {
+    // A master outside the render clusters: the first one's tree.
+    for (const ClusterPlan& c : state.layout.clusters)
+      if (c.role == proto::ClusterRole::kRender) {
+        tree = core::KdTree::build(grid, int(c.ranks.size()), kSplitAxisRule);
+        break;
+      }
+  }
+  if (!tree) return 0;
+  std::uint64_t most = 0;
+  for (int r = 0; r < tree->rankCount(); ++r)
+    most = std::max(most, std::uint64_t(core::storedBox(*tree, r, state.ghost).nodeCount()));
+  return most * core::scalarSize(state.source->type());
+}
+
+// How the render ranks get the steps of a series (brick_cache.h).
+std::string cacheText(const NodeState& state, const RuntimeSettings& settings) {
+  const core::VolumeSource& source = *state.source;
+  const std::uint64_t budget = cacheBudgetBytes(settings), step = oneStepBytes(state);
+  const std::string budgetText = "budget " + std::to_string(settings.cacheMegabytes) + " MB";
+  if (source.steps() == 1) return "single volume: nothing to read ahead";
+  if (!source.canReadPartially()) return "on demand: each step is read whole and scattered (no read-ahead)";
+  if (budget < step) return "on demand: " + budgetText + " is below one step's " + megabytes(step) + " MB";
+  const std::uint64_t fits = step > 0 ? budget / step : std::uint64_t(source.steps());
+  return "read-ahead: " + budgetText + " holds " + std::to_string(std::min<std::uint64_t>(fits, source.steps())) +
+         " of " + std::to_string(source.steps()) + " steps of " + megabytes(step) + " MB per rank";
+}
+
+// The time steps of the dataset and the one shown.
+void addTimeSteps(const NodeState& state, const RuntimeSettings& settings, std::vector<proto::KeyValue>& out) {
+  const core::VolumeSource& source = *state.source;
+  out.push_back({"timestep", std::to_string(state.scene.volume.timestep)});
+  out.push_back({"timesteps", std::to_string(source.steps())});
+  std::string times;
+  for (int k = 0; k < source.steps(); ++k) append(times, number(source.stepTime(k)));
+  out.push_back({"timestep_times", times});
+  out.push_back({"cache", cacheText(state, settings)});
+}
+
 }  // namespace
 
 std::vector<proto::KeyValue> statusEntries(const NodeState& state, const SessionStatus& session) {
@@ -89,7 +143,10 @@ std::vector<proto::KeyValue> statusEntries(const NodeState& state, const Session
       {"strategy", settings.strategy},
       {"decomposition", std::string(decompositionName(settings.decomposition))},
   };
-  if (state.source) addDataset(state, out);
+  if (state.source) {
+    addDataset(state, out);
+    addTimeSteps(state, settings, out);
+  }
   return out;
 }
 

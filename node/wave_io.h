@@ -24,6 +24,7 @@ constexpr int kTreeTag = 25002;     // composite rank -> composite rank
 constexpr int kBandTag = 25003;     // finished band -> collector
 constexpr int kPingTag = 25004;     // calibration
 constexpr int kOrderTag = 25005;    // render cluster root -> composite cluster: visibility order
+constexpr int kStepTag = 25006;     // cache rank -> render rank: a time step's brick (cache_cluster.h)
 
 // Sub-images between ranks: the smaller of the sparse codes, per image.
 constexpr core::ImageCodec kSubImageCodec = core::ImageCodec::kAuto;
@@ -40,11 +41,13 @@ struct CameraArgs {
 CameraArgs cameraArgs(const core::CameraSpec& camera);
 core::CameraSpec cameraSpec(const CameraArgs& camera);  // never automatic
 
-// One frame of a wave: its number in the request and its camera.
+// One frame of a wave: its number in the request, its camera and the time
+// step it shows.
 struct FrameView {
   std::uint32_t number = 0;
   CameraArgs camera;
-  static auto fields(auto& self) { return std::tie(self.number, self.camera); }
+  std::int32_t timestep = 0;
+  static auto fields(auto& self) { return std::tie(self.number, self.camera, self.timestep); }
 };
 
 // The part of `image` inside `rect` (an image whose rect is the intersection).

@@ -39,12 +39,13 @@ struct WireInfo {
 
 // ---- Enumerations carried in payloads (u8 on the wire) ----
 
-enum class ClusterRole : std::uint8_t { kRender = 0, kComposite = 1, kCollector = 2 };
+// kCache: ranks that read time steps ahead for the render ranks (docs/runtime.md).
+enum class ClusterRole : std::uint8_t { kRender = 0, kComposite = 1, kCollector = 2, kCache = 3 };
 enum class PixelFormat : std::uint8_t { kRgb8 = 0, kRgba8 = 1 };
 enum class Compression : std::uint8_t { kNone = 0, kRle = 1, kZlib = 2 };
 enum class PerformanceQuery : std::uint8_t { kMemory = 0, kCompositing = 1, kCache = 2 };
 
-constexpr bool isWireValue(ClusterRole v) { return v <= ClusterRole::kCollector; }
+constexpr bool isWireValue(ClusterRole v) { return v <= ClusterRole::kCache; }
 constexpr bool isWireValue(PixelFormat v) { return v <= PixelFormat::kRgba8; }
 constexpr bool isWireValue(Compression v) { return v <= Compression::kZlib; }
 constexpr bool isWireValue(PerformanceQuery v) { return v <= PerformanceQuery::kCache; }

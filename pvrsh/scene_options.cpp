@@ -1,6 +1,7 @@
 #include "scene_options.h"
 
 #include <algorithm>
+#include <climits>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -62,14 +63,16 @@ void setDataset(Apply& a) {
   a.change.dataset = true;
 }
 
-// -cluster ROLE[,RANKS]: ROLE r (render), c (composite) or k (collector).
+// -cluster ROLE[,RANKS]: ROLE r (render), c (composite), k (collector) or
+// m (cache: reads time steps ahead for the render clusters).
 // The clusters of that role are replaced: one per -group entry, or one.
 proto::ClusterRole parseRole(const std::string& option, const std::string& text) {
   const std::string role = text.substr(0, text.find(','));
   if (role == "r" || role == "render") return proto::ClusterRole::kRender;
   if (role == "c" || role == "composite") return proto::ClusterRole::kComposite;
   if (role == "k" || role == "collector") return proto::ClusterRole::kCollector;
-  argsError("CLUSTER", option + " needs ROLE[,RANKS] with ROLE r, c or k, got '" + text + "'");
+  if (role == "m" || role == "cache") return proto::ClusterRole::kCache;
+  argsError("CLUSTER", option + " needs ROLE[,RANKS] with ROLE r, c, k or m, got '" + text + "'");
 }
 
 void setLayout(Settings& s, proto::ClusterRole role, std::uint32_t ranks, const std::vector<std::uint32_t>& groups) {
@@ -170,6 +173,15 @@ void setRuntimeName(Apply& a, const char* key, std::string_view listKey) {
   a.scene({{"runtime", {{key, a.value}}}});
 }
 
+// -timestep K: the scene's "timestep" (docs/scene.md), the 0-based step of
+// a time series the session shows; the server checks it against the
+// dataset's steps.
+void setTimestep(Apply& a) { a.scene({{"timestep", parseInteger(a.option, a.value, 0, INT32_MAX)}}); }
+
+// -cachemem MB: runtime.cachemem, the brick cache's budget per render rank
+// (docs/runtime.md); the server checks the upper bound.
+void setCacheMemory(Apply& a) { a.scene({{"runtime", {{"cachemem", parseInteger(a.option, a.value, 0, INT32_MAX)}}}}); }
+
 struct OptionRow {
   const char* name;  // first field: Tcl_GetIndexFromObjStruct reads it
   void (*apply)(Apply&);
@@ -202,6 +214,8 @@ const OptionRow kOptions[] = {
     {"-light", [](Apply& a) { a.scene({{"shading", {{"light_direction", a.vec3()}}}}); }},
     {"-strategy", [](Apply& a) { setRuntimeName(a, "strategy", "strategies"); }},
     {"-decomposition", [](Apply& a) { setRuntimeName(a, "decomposition", "decompositions"); }},
+    {"-timestep", setTimestep},
+    {"-cachemem", setCacheMemory},
     {nullptr, nullptr}};
 
 void remember(Settings& s, const std::string& option, const std::string& value) {
@@ -278,10 +292,10 @@ std::string shownOption(Tcl_Interp* interp, const Settings& settings, Tcl_Obj* o
 }
 
 Tcl_Obj* layoutObj(const std::vector<proto::ClusterSpec>& clusters) {
-  static const char* const kRoles[] = {"render", "composite", "collector"};
+  static const char* const kRoles[] = {"render", "composite", "collector", "cache"};
   Tcl_Obj* list = Tcl_NewListObj(0, nullptr);
   for (const auto& c : clusters) {
-    Tcl_Obj* item[3] = {Tcl_NewStringObj(kRoles[std::min<int>(int(c.role), 2)], -1), Tcl_NewWideIntObj(c.ranks),
+    Tcl_Obj* item[3] = {Tcl_NewStringObj(kRoles[std::min<int>(int(c.role), 3)], -1), Tcl_NewWideIntObj(c.ranks),
                         Tcl_NewWideIntObj(c.group)};
     Tcl_ListObjAppendElement(nullptr, list, Tcl_NewListObj(3, item));
   }

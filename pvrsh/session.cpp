@@ -43,7 +43,8 @@ void Session::requireOpen(const char* what) const {
 
 std::uint32_t Session::send(const proto::Message& message, bool synchronous) {
   const std::uint32_t id = nextId_++;
-  if (!std::holds_alternative<proto::RenderFrame>(message) && !std::holds_alternative<proto::RenderRotation>(message))
+  if (!std::holds_alternative<proto::RenderFrame>(message) && !std::holds_alternative<proto::RenderRotation>(message) &&
+      !std::holds_alternative<proto::RenderTimeSteps>(message))
     pending_[id].synchronous = synchronous;
   if (!conn_ || !conn_->send(message, id)) {
     pending_.erase(id);

@@ -50,7 +50,7 @@ struct FrameRecord {
   int width = 0, height = 0;
 };
 
-// A render request in flight: RenderFrame or RenderRotation.
+// A render request in flight: RenderFrame, RenderRotation or RenderTimeSteps.
 struct Sequence {
   std::uint32_t id = 0;      // request id
   std::string label;         // "rotate 0,1,0 15,59:60" for reports

@@ -238,16 +238,53 @@ void checkRotation(const proto::RenderRotation& r) {
   if (const auto error = r.check(proto::Limits{})) argsError("ROTATION", "render rotate: " + error->text);
 }
 
-// :s render rotate|rotation X,Y,Z S,E:N  |  :s render frame
+// S,E?:STRIDE? as a time request: steps S to E (default: the dataset's
+// last step, asked of the server's status) every STRIDE-th (default 1).
+// The protocol's check applies before sending; whether the steps exist is
+// the server's to say.
+proto::RenderTimeSteps parseTimeRange(Session& s, const std::string& range) {
+  const auto colon = range.find(':');
+  const std::string steps = range.substr(0, colon);
+  const auto comma = steps.find(',');
+  proto::RenderTimeSteps t;
+  t.first = std::uint32_t(parseInteger("-first", steps.substr(0, comma), 0, INT32_MAX));
+  if (comma != std::string::npos && comma + 1 < steps.size()) {
+    t.last = std::uint32_t(parseInteger("-last", steps.substr(comma + 1), 0, INT32_MAX));
+  } else {
+    // The server's status says how many steps the dataset has.
+    s.requireOpen("render time");
+    const auto count = s.serverNames("timesteps");
+    if (!count || count->size() != 1)
+      argsError("TIME", "render time " + range +
+                            ": the server cannot say its last step now (no dataset, or a render in flight): give S,E");
+    t.last = std::uint32_t(std::max<std::int64_t>(0, parseInteger("timesteps", count->front(), 1, INT32_MAX) - 1));
+  }
+  if (colon != std::string::npos) t.stride = std::uint32_t(parseInteger("-stride", range.substr(colon + 1), 1, INT32_MAX));
+  if (const auto error = t.check(proto::Limits{})) argsError("TIME", "render time " + range + ": " + error->text);
+  return t;
+}
+
+// :s render rotate|rotation X,Y,Z S,E:N  |  :s render time S,E?:STRIDE?  |  :s render frame
 int renderCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
-  static const char* const kKinds[] = {"frame", "rotate", "rotation", nullptr};
+  static const char* const kKinds[] = {"frame", "rotate", "rotation", "time", nullptr};
   if (objc < 3) {
-    Tcl_WrongNumArgs(interp, 2, objv, "rotate axis start,end:steps | frame");
+    Tcl_WrongNumArgs(interp, 2, objv, "rotate axis start,end:steps | time start,end?:stride? | frame");
     return TCL_ERROR;
   }
   int kind = 0;
   if (Tcl_GetIndexFromObj(interp, objv[2], kKinds, "render", 0, &kind) != TCL_OK)
     throw TclError({"PVR", "ARGS", "RENDER"}, Tcl_GetStringResult(interp));
+  if (kind == 3) {
+    if (objc != 4) {
+      Tcl_WrongNumArgs(interp, 3, objv, "start,end?:stride?");
+      return TCL_ERROR;
+    }
+    const std::string range = str(objv[3]);
+    const proto::RenderTimeSteps t = parseTimeRange(s, range);
+    s.render(t, t.frameCount(), "time " + range);
+    Tcl_SetObjResult(interp, Tcl_NewWideIntObj(t.frameCount()));
+    return TCL_OK;
+  }
   if (kind == 0) {
     if (objc != 3) {
       Tcl_WrongNumArgs(interp, 3, objv, nullptr);
@@ -281,10 +318,12 @@ int renderCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
 
 // :s performance memory ?cluster? ?INDEX?
 // :s performance comp ?cluster? ?latency? ?INDEX?
+// :s performance cache ?cluster? ?INDEX?
 int performanceCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
-  static const char* const kQueries[] = {"memory", "comp", nullptr};
+  // In the order of the PerformanceQuery values.
+  static const char* const kQueries[] = {"memory", "comp", "cache", nullptr};
   if (objc < 3 || objc > 6) {
-    Tcl_WrongNumArgs(interp, 2, objv, "memory ?cluster? ?index? | comp ?cluster? ?latency? ?index?");
+    Tcl_WrongNumArgs(interp, 2, objv, "memory ?cluster? ?index? | comp ?cluster? ?latency? ?index? | cache ?cluster? ?index?");
     return TCL_ERROR;
   }
   int query = 0;
@@ -298,10 +337,7 @@ int performanceCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv
     cluster = std::uint32_t(parseInteger("-cluster", w, 0, 0xFFFFFFFEL));
   }
   s.requireOpen("performance");
-  const auto replies = s.query(proto::PerformanceRequest{query == 0 ? proto::PerformanceQuery::kMemory
-                                                                    : proto::PerformanceQuery::kCompositing,
-                                                         cluster},
-                               120);
+  const auto replies = s.query(proto::PerformanceRequest{proto::PerformanceQuery(query), cluster}, 120);
   for (const auto& m : replies)
     if (const auto* r = std::get_if<proto::PerformanceReply>(&m)) {
       nlohmann::json doc;

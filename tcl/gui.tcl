@@ -5,7 +5,7 @@
 # Windows:
 #   .       image view (drag to rotate), connection, dataset, image size,
 #           view buttons, rotation sequences, transfer-function editor,
-#           progress bar and status line
+#           a time slider for a series dataset, progress bar and status line
 #   .stat   per-frame times, dist/rend/comp/comm/send (stat.tcl)
 #   .layout cluster and group configuration (gui_layout.tcl)
 #
@@ -61,6 +61,10 @@ namespace eval ::pvr::gui {
     variable connected 0
     # Errors shown on the status line so far.
     variable errors 0
+    # Time series: the slider's position (a double while dragging) and the
+    # step the session shows.
+    variable timeValue 0
+    variable timestep 0
 }
 
 foreach file {stat.tcl tfeditor.tcl gui_view.tcl gui_layout.tcl} {
@@ -145,6 +149,14 @@ proc ::pvr::gui::buildMain {} {
     bind $f.size <Return> ::pvr::gui::applyImageSize
     grid $f.dataset - -sticky we -pady 2
     grid $f.sl $f.size -sticky w -pady 2
+
+    # Time series: a slider over the steps, shown only for a dataset with
+    # more than one (showTimeSteps).
+    set f [ttk::labelframe .ctl.time -text "Time step" -padding 4]
+    ttk::scale $f.scale -from 0 -to 1 -length 240 -variable ::pvr::gui::timeValue \
+        -command ::pvr::gui::timeStepMoved
+    ttk::label $f.step -width 12 -textvariable ::pvr::gui::timestep
+    pack $f.scale $f.step -side left -padx 2
 
     # View: buttons turn by 15 degrees; the image turns by dragging.
     set f [ttk::labelframe .ctl.view -text "View (drag the image to rotate)" -padding 4]
@@ -376,6 +388,7 @@ proc ::pvr::gui::readScene {} {
     variable opt
     variable rangePending
     set remote [serverStatus]
+    showTimeSteps $remote
     if {$rangePending && [dict exists $remote value_range]} {
         lassign [dict get $remote value_range] lo hi
         if {$lo < $hi} {
@@ -392,6 +405,42 @@ proc ::pvr::gui::readScene {} {
         }
     }
     return [expr {[llength $camera] == 3 ? $camera : {}}]
+}
+
+# ::pvr::gui::showTimeSteps --
+#   Shows the time slider, spanning the dataset's steps at the session's
+#   step, when the server's status says the dataset has more than one
+#   (`timesteps`); hides it otherwise.
+proc ::pvr::gui::showTimeSteps {remote} {
+    variable timeValue
+    variable timestep
+    set steps [expr {[dict exists $remote timesteps] ? [dict get $remote timesteps] : 1}]
+    if {$steps > 1} {
+        .ctl.time.scale configure -to [expr {$steps - 1}]
+        set timestep [dict get $remote timestep]
+        set timeValue $timestep
+        pack .ctl.time -after .ctl.data -fill x -pady 3
+    } else {
+        pack forget .ctl.time
+    }
+}
+
+# ::pvr::gui::timeStepMoved --
+#   The slider moved to `value`: when that is another whole step, the
+#   session shows it (set -timestep) and renders the current view.
+proc ::pvr::gui::timeStepMoved {value} {
+    variable session
+    variable timestep
+    set step [expr {int(round($value))}]
+    if {$step == $timestep} {
+        return
+    }
+    if {[catch {$session set -timestep $step} message]} {
+        status "time step $step: $message" error
+        return
+    }
+    set timestep $step
+    ::pvr::gui::view::request
 }
 
 proc ::pvr::gui::applyImageSize {} {

@@ -8,7 +8,7 @@ namespace pvr::node::actions {
 void ReportMemory::run(NodeState& state, const ReportMemory& args) {
   std::vector<std::uint64_t> bytes(std::size_t(state.world.size()), 0);
   // Ranks without a brick (composite clusters, a dedicated collector) hold none.
-  bytes[std::size_t(state.world.rank())] = state.renderer ? state.brick.byteSize() : 0;
+  bytes[std::size_t(state.world.rank())] = state.current ? state.current->bytes() : 0;
   state.world.allReduceSum(bytes);
   if (state.world.rank() != 0) return;
   const int only = args.cluster;

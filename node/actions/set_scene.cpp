@@ -2,7 +2,8 @@
 // validated by the master already. Every rank parses the document once and
 // opens the volume if it changed (headers only); the render clusters read
 // their bricks again when the volume, the ghost layers or the decomposition
-// changed, else re-classify them and rebalance a content-balanced
+// changed, show another step of it when the timestep changed (from the
+// brick cache when it holds it), else re-classify them and rebalance a content-balanced
 // decomposition that the new transfer function leaves uneven (data.h).
 #include "../data.h"
 #include "table.h"
@@ -10,20 +11,24 @@
 namespace pvr::node::actions {
 
 void SetScene::run(NodeState& state, const SetScene& args) {
-  bool redistribute = false;
+  Reload reload = Reload::kNone;
   comm::runAgreed(state.world, [&] {
     const RuntimeSettings old = state.settings;
     state.settings = args.settings;
     try {
-      redistribute = openScene(state, args.sceneJson) || state.settings.decomposition != old.decomposition;
+      reload = openScene(state, args.sceneJson);
+      if (state.settings.decomposition != old.decomposition) reload = Reload::kAll;
     } catch (...) {
       state.settings = old;
       throw;
     }
     state.matchPoolToSettings();
+    state.cache.setBudget(cacheBudgetBytes(state.settings));
+    for (auto& [key, served] : state.served) served.cache->setBudget(cacheBudgetBytes(state.settings) / state.served.size());
     classify(state);
   });
-  if (redistribute) loadBricks(state);
+  if (reload == Reload::kAll) loadBricks(state);
+  else if (reload == Reload::kStep) loadStep(state);
   else rebalanceIfNeeded(state);
 }
 

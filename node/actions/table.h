@@ -58,8 +58,21 @@ struct Wave {
   std::uint32_t request = 0;     // the client's request id, for the dumped frames' names
   std::vector<FrameView> frames;  // frame g goes to group g
   std::uint32_t lastFrame = 0;   // the request's last frame number: sent as FINAL
-  static auto fields(auto& self) { return std::tie(self.request, self.frames, self.lastFrame); }
+  // The steps of the request's next frames, in order, after this wave's:
+  // frame j of the list goes to group j % groups, whose render ranks read
+  // it ahead (brick_cache.h).
+  std::vector<std::int32_t> upcoming;
+  static auto fields(auto& self) { return std::tie(self.request, self.frames, self.lastFrame, self.upcoming); }
   static void run(NodeState& state, const Wave& args);
+};
+
+// Each render rank's brick cache: hits, misses, bytes held, read-ahead
+// seconds, into state.reply (report_cache.cpp).
+struct ReportCache {
+  static constexpr std::string_view kName = "report_cache";
+  std::int32_t cluster = -1;  // a cluster index, or -1 for all
+  static auto fields(auto& self) { return std::tie(self.cluster); }
+  static void run(NodeState& state, const ReportCache& args);
 };
 
 // Dataset bytes per rank and cluster, into state.reply (report_memory.cpp).
@@ -90,6 +103,7 @@ using ActionTable = ActionList<
     actions::SetScene,
     actions::Wave,
     actions::ReportMemory,
-    actions::CompLatency>;
+    actions::CompLatency,
+    actions::ReportCache>;
 
 }  // namespace pvr::node

@@ -13,6 +13,8 @@
 // dispatcher's one world agreement then reports the lowest rank's.
 #include <chrono>
 
+#include "../cache_cluster.h"
+#include "../data.h"
 #include "../wave_collect.h"
 #include "../wave_composite.h"
 #include "table.h"
@@ -21,27 +23,51 @@ namespace pvr::node::actions {
 
 namespace {
 
-// Local: ray-casts this rank's brick for its group's frame, if it has one.
-void renderMyFrame(NodeState& state, std::optional<comm::Failure>& failure) {
+// The steps my group shows after this wave, in order: every groups-th of
+// the request's upcoming ones.
+std::vector<int> myUpcoming(const std::vector<std::int32_t>& upcoming, int group, int groups) {
+  std::vector<int> mine;
+  for (std::size_t j = std::size_t(group); j < upcoming.size(); j += std::size_t(groups)) mine.push_back(upcoming[j]);
+  return mine;
+}
+
+// Collective over each render cluster whose group has a frame, then local:
+// shows the frame's time step (from the cache, or read now), starts
+// reading the group's next steps ahead, and ray-casts this rank's brick.
+void renderMyFrame(NodeState& state, const Wave& args, std::optional<comm::Failure>& failure) {
   if (!state.renders()) return;
   const ClusterPlan& me = *state.myCluster();
   if (me.group >= int(state.wave.size())) return;
   WaveFrame& w = state.wave[std::size_t(me.group)];
   const int width = state.scene.image.width, height = state.scene.image.height;
   try {
-    if (!state.renderer) throw Error(ErrorCode::kInvalidArgument, "no dataset: send SetScene with a dataset first");
+    showStep(state, w.timestep);
+    state.cache.readAhead(myUpcoming(args.upcoming, me.group, state.layout.groups));
+    if (!state.current) throw Error(ErrorCode::kInvalidArgument, "no dataset: send SetScene with a dataset first");
     state.maybeFail("render");
     const auto start = std::chrono::steady_clock::now();
     const core::Camera camera(w.camera, width, height);
     // A cluster that shares the frame's scanlines with others casts only
     // the rays of its own band.
     const core::PixelRect band = bandRect(width, height, me.band, me.bands);
-    w.partial = state.renderer->render(camera, state.renderOptions, *state.pool, nullptr,
+    w.partial = state.current->renderer->render(camera, state.renderOptions, *state.pool, nullptr,
                                        me.bands > 1 ? &band : nullptr);
     w.rend = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   } catch (...) {
     failure = comm::failureOf(std::current_exception(), state.world.rank());
     w.partial = core::Image(width, height, core::PixelRect{});  // composites as nothing
+  }
+}
+
+// Cache ranks: each render cluster I serve gets its frame's step, and its
+// group's next steps are read ahead (cache_cluster.h).
+void serveMyClusters(NodeState& state, const Wave& args) {
+  const ClusterPlan* me = state.myCluster();
+  if (!me || me->role != proto::ClusterRole::kCache) return;
+  for (int c : me->serves) {
+    const int group = state.layout.clusters[std::size_t(c)].group;
+    if (group < int(state.wave.size()))
+      serveStep(state, c, state.wave[std::size_t(group)].timestep, myUpcoming(args.upcoming, group, state.layout.groups));
   }
 }
 
@@ -53,10 +79,12 @@ void Wave::run(NodeState& state, const Wave& args) {
     WaveFrame w;
     w.number = f.number;
     w.camera = cameraSpec(f.camera);
+    w.timestep = f.timestep;
     state.wave.push_back(std::move(w));
   }
   std::optional<comm::Failure> failure;
-  renderMyFrame(state, failure);
+  serveMyClusters(state, args);
+  renderMyFrame(state, args, failure);
   compositeWave(state, failure);
   collectWave(state, args.request, args.lastFrame, failure);
   if (failure) throw comm::FailureError(*failure);

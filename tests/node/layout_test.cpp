@@ -36,6 +36,18 @@ TEST_CASE("clusters covering all but one rank leave rank 0 as a dedicated collec
   CHECK(l.clusterOfRank[0] == -1);
 }
 
+TEST_CASE("a cache cluster serves the render clusters of its group, j mod M") {
+  const auto l = node::makeLayout({{ClusterRole::kRender, 1, 0}, {ClusterRole::kRender, 1, 0}, {ClusterRole::kCache, 1, 0}}, 4);
+  CHECK(l.dedicatedMaster);
+  CHECK(l.clusters[0].cacheCluster == 2);
+  CHECK(l.clusters[1].cacheCluster == 2);
+  CHECK(l.clusters[2].serves == std::vector<int>{0, 1});
+  CHECK(l.clusters[2].ranks == std::vector<int>{3});
+  CHECK(node::roleName(ClusterRole::kCache) == "cache");
+  CHECK_THROWS_WITH(node::makeLayout({{ClusterRole::kRender, 2, 0}, {ClusterRole::kCache, 1, 5}}, 4),
+                    Catch::Contains("cache cluster of group 5 has no render cluster to serve"));
+}
+
 TEST_CASE("impossible layouts are refused with a reason") {
   CHECK_THROWS_WITH(node::makeLayout({{ClusterRole::kRender, 8, 0}}, 4), Catch::Contains("job of 4"));
   CHECK_THROWS_WITH(node::makeLayout({{ClusterRole::kComposite, 4, 0}}, 4), Catch::Contains("no render cluster"));

@@ -12,13 +12,15 @@ using nlohmann::json;
 TEST_CASE("settingsFrom reads every key over the defaults") {
   const auto s = node::settingsFrom(json::parse(
       R"({"strategy": "radix-k", "decomposition": "balanced", "rebalance_threshold": 1.5,
-          "pixels": "rgb8", "compression": "none", "threads": 3})"));
+          "pixels": "rgb8", "compression": "none", "threads": 3, "cachemem": 12})"));
   CHECK(s.strategy == "radix-k");
   CHECK(s.decomposition == node::Decomposition::kBalanced);
   CHECK(s.rebalanceThreshold == 1.5);
   CHECK(s.format == proto::PixelFormat::kRgb8);
   CHECK(s.compression == proto::Compression::kNone);
   CHECK(s.threads == 3);
+  CHECK(s.cacheMegabytes == 12);
+  CHECK(node::cacheBudgetBytes(s) == 12u << 20);
   CHECK(node::settingsFrom(json::object()) == node::RuntimeSettings{});
 }
 
@@ -49,6 +51,8 @@ TEST_CASE("settingsFrom names the key of a wrong value, type or name") {
   CHECK_THAT(refusal({{"pixels", 8}}), Catch::Contains("runtime.pixels: must be a string"));
   CHECK_THAT(refusal({{"compression", "lz4"}}), Catch::Contains("none, rle, zlib"));
   CHECK_THAT(refusal({{"rebalance_threshold", 0.5}}), Catch::Contains("runtime.rebalance_threshold"));
+  CHECK_THAT(refusal({{"cachemem", -1}}), Catch::Contains("runtime.cachemem: must be an integer number of MB"));
+  CHECK_THAT(refusal({{"cachemem", 1.5}}), Catch::Contains("runtime.cachemem"));
   CHECK_THAT(refusal({{"colour", 1}}), Catch::Contains("runtime.colour: unknown key"));
   CHECK_THAT(refusal(json::array()), Catch::Contains("runtime: must be an object"));
 }

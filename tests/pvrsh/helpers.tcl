@@ -54,6 +54,32 @@ proc ::pvrtest::makeData {dir} {
     return $dir
 }
 
+# ::pvrtest::makeSeries DIR N: a time series of N steps beside the ball
+# (docs/scene.md, series sidecar): step k is ball/step_K.raw + step_K.json,
+# the ball's values times 1 - 0.2 k, listed by ball/ball.series.json at
+# times 0, 0.5, 1, ... Returns the catalog name of the series.
+proc ::pvrtest::makeSeries {dir n} {
+    set ball [file join $dir ball]
+    set f [open [file join $ball ball.raw] rb]
+    binary scan [read $f] cu* values
+    close $f
+    set steps {}
+    for {set k 0} {$k < $n} {incr k} {
+        set scaled [lmap v $values {expr {int($v * (1 - 0.2 * $k))}}]
+        set f [open [file join $ball step_$k.raw] wb]
+        puts -nonewline $f [binary format c* $scaled]
+        close $f
+        set f [open [file join $ball step_$k.json] w]
+        puts $f [format {{"dims": [32, 32, 32], "dtype": "uint8", "spacing": [1, 1, 1], "origin": [0, 0, 0], "raw_file": "step_%d.raw", "endian": "little"}} $k]
+        close $f
+        lappend steps [format {{"time": %s, "file": "step_%d.json"}} [expr {0.5 * $k}] $k]
+    }
+    set f [open [file join $ball ball.series.json] w]
+    puts $f "{\"series\": \[[join $steps {, }]\]}"
+    close $f
+    return ball/ball.series.json
+}
+
 # ::pvrtest::startPvrd ?ARGS?: starts pvrd on 127.0.0.1:0 over a fresh data
 # directory; returns the port. Stopped by stopPvrd (or at exit).
 proc ::pvrtest::startPvrd {args} {

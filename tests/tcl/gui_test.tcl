@@ -18,7 +18,10 @@
 #   6. a rotation sequence fills the progress bar and the performance graph;
 #   7. the cluster and group window shows the layout, asks the server for
 #      memory per cluster, applies the form, and its Strategy box offers
-#      exactly the server's strategies, each of which renders without error.
+#      exactly the server's strategies, each of which renders without error;
+#   8. with -series 1 (the renderer has the series format): the time slider
+#      is hidden for a single volume and shown for a series of 3 steps;
+#      moving it sets the session's step and renders a new frame.
 # Writes DIR/gui_frame.png (the photo) and DIR/gui_screenshot.png (the whole
 # screen, when ImageMagick's import is installed). Exits 0 when all pass, 1
 # otherwise; gives up after 80 s.
@@ -26,7 +29,7 @@
 package require Tk
 
 # ---- Options ----
-array set arg {-pvrd "" -node "" -source "" -out .}
+array set arg {-pvrd "" -node "" -source "" -out . -series 0}
 foreach {k v} $argv {
     set arg($k) $v
 }
@@ -114,6 +117,24 @@ puts $f {{"dims": [32, 32, 32], "dtype": "uint8", "spacing": [1, 1, 1], "origin"
  "raw_file": "block.raw", "endian": "little", "stats": {"min": 0, "max": 200}}}
 close $f
 
+# A series of 3 steps of the same grid: step k is the volume's values
+# times 1 - 0.3 k (docs/scene.md, series sidecar).
+file mkdir [file join $data blockseries]
+binary scan $bytes cu* values
+set steps {}
+for {set k 0} {$k < 3} {incr k} {
+    set f [open [file join $data blockseries step_$k.raw] wb]
+    puts -nonewline $f [binary format c* [lmap v $values {expr {int($v * (1 - 0.3 * $k))}}]]
+    close $f
+    set f [open [file join $data blockseries step_$k.json] w]
+    puts $f [format {{"dims": [32, 32, 32], "dtype": "uint8", "spacing": [1, 1, 1], "origin": [0, 0, 0], "raw_file": "step_%d.raw", "endian": "little"}} $k]
+    close $f
+    lappend steps [format {{"time": %d, "file": "step_%d.json"}} $k $k]
+}
+set f [open [file join $data blockseries blockseries.series.json] w]
+puts $f "{\"series\": \[[join $steps {, }]\]}"
+close $f
+
 set env(OMPI_ALLOW_RUN_AS_ROOT) 1
 set env(OMPI_ALLOW_RUN_AS_ROOT_CONFIRM) 1
 # `timeout` ends pvrd even when this script is killed before finish runs.
@@ -183,6 +204,8 @@ set remote [dict get [$::pvr::gui::session list status] remote]
 check "first frame: the view starts at the server's camera" \
     {$::pvr::gui::view::base ne {} && $::pvr::gui::view::azimuth == 0 &&
      $::pvr::gui::view::elevation == $::pvr::gui::view::baseElevation} "camera [dict filter $remote key camera_*]"
+update
+check "first frame: no time slider for a single volume" {![winfo ismapped .ctl.time]}
 check "first frame: the editor spans the server's value range" \
     {[::pvr::gui::tfeditor::range .ctl.tf.editor] == [lmap v [dict get $remote value_range] {expr {double($v)}}]} \
     "range [::pvr::gui::tfeditor::range .ctl.tf.editor], value_range [dict get $remote value_range]"
@@ -349,7 +372,26 @@ foreach name [lreverse $offered] {
         "in force $inForce; status: $::pvr::gui::statusText"
 }
 
-# ---- Step 10: artifacts ----
+# ---- Step 10: the time slider of a series ----
+if {$arg(-series)} {
+    set sentBefore $::pvr::gui::view::sent
+    ::pvr::gui::loadDataset blockseries/blockseries.series.json
+    waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+    update
+    check "time: the slider shows for a series, over its 3 steps" \
+        {[winfo ismapped .ctl.time] && [.ctl.time.scale cget -to] == 2 && $::pvr::gui::timestep == 0} \
+        "mapped [winfo ismapped .ctl.time], to [.ctl.time.scale cget -to], step $::pvr::gui::timestep"
+    set frameStep0 [pixels]
+    set sentBefore $::pvr::gui::view::sent
+    .ctl.time.scale set 2
+    waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+    set remoteStep [dict get [$::pvr::gui::session list status] remote timestep]
+    check "time: moving the slider sets step 2 and renders another frame" \
+        {$remoteStep == 2 && [pixels] ne $frameStep0 && $::pvr::gui::errors == 0} \
+        "server step $remoteStep; status: $::pvr::gui::statusText"
+}
+
+# ---- Step 11: artifacts ----
 $photo write [file join $arg(-out) gui_frame.png] -format png
 check "artifact: gui_frame.png written" {[file size [file join $arg(-out) gui_frame.png]] > 100}
 update

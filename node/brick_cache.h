@@ -1,0 +1,111 @@
+// The caching cluster of paper 003 (section 7) on the render ranks: each
+// rank keeps the bricks of time steps it showed or will show, read and
+// preprocessed (value range, macrocell grid) so that a step is ready to
+// classify and render. While the current step renders, a background thread
+// reads the upcoming steps' bricks, within a per-rank memory budget
+// (RuntimeSettings::cacheMegabytes). What does not fit is read on demand.
+//
+// Eviction: a step the current request will not show again goes first
+// (least recently used among those), then the least recently used of the
+// others; the brick on screen is never evicted (its owner holds it).
+// Read-ahead never evicts a step it still needs to make room for a later
+// one: it stops there.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <list>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "brick.h"
+#include "raycast/raycaster.h"
+
+namespace pvr::node {
+
+// One step's brick for this rank, with its renderer (macrocells built).
+// Held by pointer: the renderer refers to `brick`, so it never moves.
+struct ReadyBrick {
+  int step = 0;
+  core::Brick brick;
+  std::unique_ptr<core::BrickRenderer> renderer;
+  double readSeconds = 0;        // I/O (brick.loadTimes().read)
+  double preprocessSeconds = 0;  // fused preprocessing in the reader plus the renderer's build
+  std::uint64_t bytes() const { return brick.byteSize(); }
+};
+
+// Builds the renderer over `brick` (timed) and wraps both.
+std::shared_ptr<ReadyBrick> makeReady(core::Brick&& brick, int step);
+
+// What `performance cache` reports for one rank.
+struct CacheStats {
+  std::uint64_t hits = 0;       // steps found held or being read ahead when needed
+  std::uint64_t misses = 0;     // steps read on demand
+  std::uint64_t bytesHeld = 0;  // brick bytes of the steps held
+  std::uint64_t stepsHeld = 0;
+  double readAheadSeconds = 0;  // background reading and preprocessing
+};
+
+class BrickCache {
+ public:
+  // Reads this rank's brick of one step; called on the background thread
+  // too, so it must not communicate.
+  using Reader = std::function<core::Brick(int step)>;
+
+  BrickCache() = default;
+  BrickCache(const BrickCache&) = delete;
+  BrickCache& operator=(const BrickCache&) = delete;
+  ~BrickCache() { clear(); }
+
+  // Drops every step (a new volume, tree or ghost layers) and reads with
+  // `reader` from now on; a null reader allows no reading ahead.
+  void reset(Reader reader);
+  // Drops every step and the reader.
+  void clear() { reset(nullptr); }
+  void setBudget(std::uint64_t bytes);
+  std::uint64_t budget() const { return budget_; }
+
+  // Keeps `ready` (a step just read by a distribution) if it fits.
+  void insert(const std::shared_ptr<ReadyBrick>& ready);
+  // The brick of `step`: held or being read ahead (a hit, waiting for the
+  // read to end), or read now on this thread (a miss). Throws what the
+  // reader throws.
+  std::shared_ptr<ReadyBrick> take(int step);
+  // Reads `steps` (in the order they will be shown) on the background
+  // thread, as many as the budget holds. Replaces any earlier list; a read
+  // in progress goes on.
+  void readAhead(std::vector<int> steps);
+
+  CacheStats stats() const;
+
+ private:
+  void stopReadAhead();  // waits for the background thread
+  void readAheadLoop();  // the background thread: reads queued_ in order
+  // Under mutex_: makes room for `bytes`, evicting steps not in `keep`
+  // (and never one somebody else holds). False if it cannot.
+  bool makeRoom(std::uint64_t bytes, const std::vector<int>& keep, bool evictWanted);
+  void holdLocked(const std::shared_ptr<ReadyBrick>& ready);  // under mutex_
+  void touchLocked(int step);
+  void evictLocked(int step);  // under mutex_
+
+  Reader reader_;
+  std::uint64_t budget_ = 0;
+  mutable std::mutex mutex_;
+  std::condition_variable done_;  // a background read ended
+  std::map<int, std::shared_ptr<ReadyBrick>> held_;
+  std::list<int> recent_;  // held steps, most recently used first
+  std::vector<int> wanted_;  // the upcoming steps of the last readAhead
+  std::uint64_t stepBytes_ = 0;  // one step's brick bytes, once one was read
+  int reading_ = -1;  // the step the background thread is reading; -1: none
+  std::vector<int> queued_;  // the steps it will read after that, in order
+  bool stop_ = false;    // the background thread ends after its current read
+  bool active_ = false;  // the background thread is running
+  std::thread worker_;
+  CacheStats stats_;
+};
+
+}  // namespace pvr::node

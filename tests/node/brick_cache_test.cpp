@@ -1,0 +1,94 @@
+// The render ranks' brick cache (node/brick_cache.h), serially, over a
+// procedural volume whose step k reads as a brick filled with k: what it
+// holds within its budget, what it evicts first, and that read-ahead turns
+// the next steps into hits.
+#include <catch2/catch.hpp>
+#include <atomic>
+
+#include "brick_cache.h"
+#include "io/volume_io.h"
+
+using namespace pvr;
+using node::BrickCache;
+
+namespace {
+
+constexpr int kSide = 16;  // one step: 16^3 float32 = 16 KiB
+
+// A reader whose step k is a brick of the whole grid with every value k;
+// counts its calls.
+struct StepReader {
+  std::unique_ptr<core::VolumeSource> source = core::openProcedural("constant-slab", {kSide, kSide, kSide});
+  std::shared_ptr<std::atomic<int>> reads = std::make_shared<std::atomic<int>>(0);
+  BrickCache::Reader reader() const {
+    return [src = source.get(), reads = reads](int step) {
+      ++*reads;
+      core::Brick b = src->readAll();
+      for (std::int64_t i = 0; i < b.stored().nodeCount(); ++i) b.as<float>()[i] = float(step);
+      b.updateValueRange();
+      return b;
+    };
+  }
+};
+
+constexpr std::uint64_t kStepBytes = std::uint64_t(kSide) * kSide * kSide * 4;
+
+}  // namespace
+
+TEST_CASE("the brick cache holds steps within its budget and evicts the least recently used first") {
+  StepReader steps;
+  BrickCache cache;
+  cache.setBudget(2 * kStepBytes);  // two steps
+  cache.reset(steps.reader());
+  // Each take of a step not held reads it (a miss) and keeps it.
+  CHECK(cache.take(0)->brick.valueRange().max == 0);
+  CHECK(cache.take(1)->brick.valueRange().max == 1);
+  CHECK(cache.take(0)->step == 0);  // held: a hit
+  CHECK(cache.stats().hits == 1);
+  CHECK(cache.stats().misses == 2);
+  CHECK(cache.stats().bytesHeld == 2 * kStepBytes);
+  // Step 2 evicts step 1, used longest ago.
+  cache.take(2);
+  CHECK(cache.stats().stepsHeld == 2);
+  cache.take(0);
+  CHECK(cache.stats().hits == 2);
+  cache.take(1);
+  CHECK(cache.stats().misses == 4);
+  CHECK(*steps.reads == 4);
+}
+
+TEST_CASE("a budget below one step holds nothing and every step is read when needed") {
+  StepReader steps;
+  BrickCache cache;
+  cache.setBudget(kStepBytes - 1);
+  cache.reset(steps.reader());
+  cache.readAhead({1, 2});  // nothing fits: nothing is read ahead
+  for (int pass = 0; pass < 2; ++pass)
+    for (int k = 0; k < 3; ++k) CHECK(cache.take(k)->brick.valueRange().min == k);
+  CHECK(cache.stats().hits == 0);
+  CHECK(cache.stats().misses == 6);
+  CHECK(cache.stats().bytesHeld == 0);
+}
+
+TEST_CASE("read-ahead makes the upcoming steps hits, and never evicts a step on screen") {
+  StepReader steps;
+  BrickCache cache;
+  cache.setBudget(3 * kStepBytes);
+  cache.reset(steps.reader());
+  const std::shared_ptr<node::ReadyBrick> onScreen = cache.take(0);
+  cache.readAhead({1, 2, 3});  // room for two beside the step on screen
+  CHECK(cache.take(1)->step == 1);
+  CHECK(cache.take(2)->step == 2);
+  CHECK(cache.stats().hits == 2);
+  CHECK(cache.stats().misses == 1);
+  CHECK(cache.stats().readAheadSeconds > 0);
+  // Step 3 did not fit: read now, evicting 1 (used before 2), not 0.
+  cache.take(3);
+  CHECK(cache.stats().misses == 2);
+  cache.take(0);
+  CHECK(cache.stats().hits == 3);
+  // A smaller budget drops steps at once.
+  cache.setBudget(kStepBytes);
+  CHECK(cache.stats().bytesHeld <= kStepBytes);
+  CHECK(onScreen->brick.valueRange().max == 0);  // its owner still has it
+}
