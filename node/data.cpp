@@ -182,7 +182,7 @@ void showStep(NodeState& state, int step) {
 }
 
 void classify(NodeState& state) {
-  if (state.current) state.current->renderer->classify(state.scene.transfer, state.renderOptions);
+  if (state.current) state.current->renderer->classify(state.scene.transfer, state.renderOptions, state.pool.get());
 }
 
 void rebalanceIfNeeded(NodeState& state) {
@@ -195,7 +195,7 @@ void rebalanceIfNeeded(NodeState& state) {
   std::uint64_t mine = 0;
   comm::runAgreed(cluster, [&] {
     const core::TransferTable table(state.scene.transfer, state.scene.sampling.step);
-    content = core::countContent(state.current->brick, table);
+    content = core::countContent(state.current->brick, table, {8, 8, 8}, state.pool.get());
     mine = core::totalContent(content);
   });
   cluster.allReduceSum(content.counts);
