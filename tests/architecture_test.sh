@@ -49,7 +49,7 @@ check "OpenImageIO only in renderer/image_io.cpp" '#include *<OpenImageIO/' '^re
 check "node/ includes no image file code (node/image_output.h loads it)" '#include *"image_io\.h"' '^$' node
 # ctest splits a discovered Catch2 name at ';' and then runs no test at all,
 # which passes: a name with ';' is a test that can never fail.
-bad=$(grep -rnE 'TEST_CASE\("[^"]*;' tests 2>/dev/null || true)
+bad=$(grep -rnE 'TEST_CASE(_METHOD)?\(([A-Za-z_:]+, *)?"[^"]*;' tests 2>/dev/null || true)
 if [ -n "$bad" ]; then
   echo "FAIL: Catch2 test names with ';' (ctest runs nothing for them):"; echo "$bad" | sed 's/^/  /'
   status=1

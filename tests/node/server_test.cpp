@@ -51,28 +51,46 @@ constexpr int kDims[3] = {40, 36, 33};
 // made to see empty (Launch::hiddenFromLastRank).
 const fs::path kHidden = kTmp / "data" / "hidden";
 
+// ctest runs several of these test processes at once, each writing the
+// same data files while the others' ranks read them: every file is
+// written under a scratch directory of this process and renamed into place,
+// so a reader sees a whole file (the same bytes from every writer).
+template <typename Write>
+void writeAtomically(const fs::path& dir, Write write) {
+  const fs::path scratch = dir / (".scratch-" + std::to_string(::getpid()));
+  fs::create_directories(scratch);
+  write(scratch);
+  for (const auto& entry : fs::directory_iterator(scratch)) fs::rename(entry.path(), dir / entry.path().filename());
+  fs::remove_all(scratch);
+}
+
 // A float32 raw volume with its JSON sidecar in `dir`.
 void writeVolume(const fs::path& dir) {
   fs::create_directories(dir);
   const core::Brick whole = core::openProcedural("shepp-logan", {kDims[0], kDims[1], kDims[2]})->readAll();
-  std::ofstream raw(dir / "phantom.raw", std::ios::binary);
   const auto nodes = whole.stored().nodeCount();
   REQUIRE(whole.byteSize() == std::size_t(nodes) * 4);
-  raw.write(reinterpret_cast<const char*>(whole.bytes()), std::streamsize(whole.byteSize()));
-  std::ofstream(dir / "phantom.json") << nlohmann::json{{"dims", {kDims[0], kDims[1], kDims[2]}},
-                                                        {"dtype", "float32"},
-                                                        {"spacing", {1.0, 1.0, 1.25}},
-                                                        {"raw_file", "phantom.raw"}}
-                                             .dump();
+  auto writeRaw = [&](const fs::path& path) {
+    std::ofstream raw(path, std::ios::binary);
+    raw.write(reinterpret_cast<const char*>(whole.bytes()), std::streamsize(whole.byteSize()));
+  };
+  writeAtomically(dir, [&](const fs::path& scratch) {
+    writeRaw(scratch / "phantom.raw");
+    std::ofstream(scratch / "phantom.json") << nlohmann::json{{"dims", {kDims[0], kDims[1], kDims[2]}},
+                                                              {"dtype", "float32"},
+                                                              {"spacing", {1.0, 1.0, 1.25}},
+                                                              {"raw_file", "phantom.raw"}}
+                                                   .dump();
+    std::ofstream(scratch / "split.json") << nlohmann::json{{"dims", {kDims[0], kDims[1], kDims[2]}},
+                                                            {"dtype", "float32"},
+                                                            {"spacing", {1.0, 1.0, 1.25}},
+                                                            {"raw_file", "hidden/split.raw"}}
+                                                 .dump();
+  });
   // The same volume with its voxels under kHidden, which one rank may be
   // made not to see.
   fs::create_directories(kHidden);
-  fs::copy_file(dir / "phantom.raw", kHidden / "split.raw", fs::copy_options::overwrite_existing);
-  std::ofstream(dir / "split.json") << nlohmann::json{{"dims", {kDims[0], kDims[1], kDims[2]}},
-                                                      {"dtype", "float32"},
-                                                      {"spacing", {1.0, 1.0, 1.25}},
-                                                      {"raw_file", "hidden/split.raw"}}
-                                           .dump();
+  writeAtomically(kHidden, [&](const fs::path& scratch) { writeRaw(scratch / "split.raw"); });
 }
 
 const char* kScene = R"({
@@ -350,25 +368,17 @@ std::string stepFile(int k) { return "series_" + std::to_string(k) + ".json"; }
 
 void writeSeries(const fs::path& dir) {
   const core::Brick whole = core::openProcedural("shepp-logan", {kDims[0], kDims[1], kDims[2]})->readAll();
-  nlohmann::json steps = nlohmann::json::array();
-  for (int k = 0; k < kSteps; ++k) {
-    core::Brick step = whole;
-    float* v = step.as<float>();
-    for (std::int64_t i = 0; i < step.stored().nodeCount(); ++i) v[i] *= float(1 - 0.2 * k);
-    core::writeRawJsonVolume(step, dir.string(), "series_" + std::to_string(k), "step " + std::to_string(k));
-    steps.push_back({{"time", 0.5 * k}, {"file", stepFile(k)}});
-  }
-  std::ofstream(dir / kSeries) << nlohmann::json{{"series", steps}}.dump();
-}
-
-// The series sidecar is the format "series" of branch i11-series; until
-// it is merged the series tests say so and stop. They run (and fail when
-// wrong) as soon as the format is registered.
-bool seriesFormatRegistered() {
-  for (const core::VolumeFormat& f : core::volumeFormats())
-    if (std::string_view(f.name) == "series") return true;
-  WARN("the series format is not registered (branch i11-series): series tests not run");
-  return false;
+  writeAtomically(dir, [&](const fs::path& scratch) {
+    nlohmann::json steps = nlohmann::json::array();
+    for (int k = 0; k < kSteps; ++k) {
+      core::Brick step = whole;
+      float* v = step.as<float>();
+      for (std::int64_t i = 0; i < step.stored().nodeCount(); ++i) v[i] *= float(1 - 0.2 * k);
+      core::writeRawJsonVolume(step, scratch.string(), "series_" + std::to_string(k), "step " + std::to_string(k));
+      steps.push_back({{"time", 0.5 * k}, {"file", stepFile(k)}});
+    }
+    std::ofstream(scratch / kSeries) << nlohmann::json{{"series", steps}}.dump();
+  });
 }
 
 struct Fixture {
@@ -503,8 +513,7 @@ std::pair<std::uint64_t, std::uint64_t> cacheCounts(Job& job) {
   return {hits, misses};
 }
 
-TEST_CASE_METHOD(Fixture, "render time: each frame equals its step's volume; the cache hits on a second pass", "[series]") {
-  if (!seriesFormatRegistered()) return;
+TEST_CASE_METHOD(Fixture, "render time: each frame equals its step's volume, and the cache hits on a second pass", "[series]") {
   Job job(2, {});
   openSeries(job);
   auto status = statusOf(job);
@@ -535,8 +544,7 @@ TEST_CASE_METHOD(Fixture, "render time: each frame equals its step's volume; the
   CHECK(job.close());
 }
 
-TEST_CASE_METHOD(Fixture, "a caching cluster renders the same frames; its render ranks read no step after the first", "[series]") {
-  if (!seriesFormatRegistered()) return;
+TEST_CASE_METHOD(Fixture, "a caching cluster renders the same frames, and its render ranks read no step after the first", "[series]") {
   // Rank 0 the dedicated master, ranks 1-2 render, rank 3 caches for them.
   Job job(4, {});
   job.send(proto::SessionOpen{4, {{ClusterRole::kRender, 2, 0}, {ClusterRole::kCache, 1, 0}}, ""});
@@ -581,8 +589,7 @@ TEST_CASE_METHOD(Fixture, "a caching cluster renders the same frames; its render
   CHECK(job.close());
 }
 
-TEST_CASE_METHOD(Fixture, "a bad step is a clear error and the session serves on; a budget below one step reads on demand", "[series]") {
-  if (!seriesFormatRegistered()) return;
+TEST_CASE_METHOD(Fixture, "a bad step is a clear error and the session serves on, and a budget below one step reads on demand", "[series]") {
   Job job(2, {});
   openSeries(job);
 

@@ -19,7 +19,7 @@
 #   7. the cluster and group window shows the layout, asks the server for
 #      memory per cluster, applies the form, and its Strategy box offers
 #      exactly the server's strategies, each of which renders without error;
-#   8. with -series 1 (the renderer has the series format): the time slider
+#   8. the time slider
 #      is hidden for a single volume and shown for a series of 3 steps;
 #      moving it sets the session's step and renders a new frame.
 # Writes DIR/gui_frame.png (the photo) and DIR/gui_screenshot.png (the whole
@@ -29,7 +29,7 @@
 package require Tk
 
 # ---- Options ----
-array set arg {-pvrd "" -node "" -source "" -out . -series 0}
+array set arg {-pvrd "" -node "" -source "" -out .}
 foreach {k v} $argv {
     set arg($k) $v
 }
@@ -373,23 +373,21 @@ foreach name [lreverse $offered] {
 }
 
 # ---- Step 10: the time slider of a series ----
-if {$arg(-series)} {
-    set sentBefore $::pvr::gui::view::sent
-    ::pvr::gui::loadDataset blockseries/blockseries.series.json
-    waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
-    update
-    check "time: the slider shows for a series, over its 3 steps" \
-        {[winfo ismapped .ctl.time] && [.ctl.time.scale cget -to] == 2 && $::pvr::gui::timestep == 0} \
-        "mapped [winfo ismapped .ctl.time], to [.ctl.time.scale cget -to], step $::pvr::gui::timestep"
-    set frameStep0 [pixels]
-    set sentBefore $::pvr::gui::view::sent
-    .ctl.time.scale set 2
-    waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
-    set remoteStep [dict get [$::pvr::gui::session list status] remote timestep]
-    check "time: moving the slider sets step 2 and renders another frame" \
-        {$remoteStep == 2 && [pixels] ne $frameStep0 && $::pvr::gui::errors == 0} \
-        "server step $remoteStep; status: $::pvr::gui::statusText"
-}
+set sentBefore $::pvr::gui::view::sent
+::pvr::gui::loadDataset blockseries/blockseries.series.json
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+update
+check "time: the slider shows for a series, over its 3 steps" \
+    {[winfo ismapped .ctl.time] && [.ctl.time.scale cget -to] == 2 && $::pvr::gui::timestep == 0} \
+    "mapped [winfo ismapped .ctl.time], to [.ctl.time.scale cget -to], step $::pvr::gui::timestep"
+set frameStep0 [pixels]
+set sentBefore $::pvr::gui::view::sent
+.ctl.time.scale set 2
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+set remoteStep [dict get [$::pvr::gui::session list status] remote timestep]
+check "time: moving the slider sets step 2 and renders another frame" \
+    {$remoteStep == 2 && [pixels] ne $frameStep0 && $::pvr::gui::errors == 0} \
+    "server step $remoteStep; status: $::pvr::gui::statusText"
 
 # ---- Step 11: artifacts ----
 $photo write [file join $arg(-out) gui_frame.png] -format png
