@@ -62,6 +62,11 @@ class RawVolumeSource final : public VolumeSource {
 
 }  // namespace
 
+std::unique_ptr<VolumeSource> rawVolumeSource(std::string name, const GridGeometry& grid, ScalarType type,
+                                              RawLayout layout) {
+  return std::make_unique<RawVolumeSource>(std::move(name), grid, type, std::move(layout));
+}
+
 std::unique_ptr<VolumeSource> openRawVolume(std::string name, const GridGeometry& grid,
                                             ScalarType type, RawLayout layout, SizeRule rule) {
   const std::string header = layout.headerPath.empty() ? layout.dataPath : layout.headerPath;
@@ -83,7 +88,7 @@ std::unique_ptr<VolumeSource> openRawVolume(std::string name, const GridGeometry
     if (layout.offset > 0) what += std::to_string(layout.offset) + " bytes before the voxels + ";
     failAt(ErrorCode::kBadFile, layout.dataPath, what + shapeText(grid, type) + ")");
   });
-  return std::make_unique<RawVolumeSource>(std::move(name), grid, type, std::move(layout));
+  return rawVolumeSource(std::move(name), grid, type, std::move(layout));
 }
 
 Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType type,

@@ -50,6 +50,12 @@ enum class SizeRule : std::uint8_t { kExact, kAtLeast };
 // whose readBox reads only the requested box. `name` is what describe()
 // shows ("ct.nhdr"). Throws pvr::Error naming the file on any mismatch:
 // "/x/ct.raw: file has 1000 bytes, header needs 14155776 (256x256x108 int16)".
+// A source over `layout` whose data size the caller has checked already
+// (openRawVolume does; a series of steps stored back to back checks all
+// steps at once instead of once per step).
+std::unique_ptr<VolumeSource> rawVolumeSource(std::string name, const GridGeometry& grid, ScalarType type,
+                                              RawLayout layout);
+
 std::unique_ptr<VolumeSource> openRawVolume(std::string name, const GridGeometry& grid,
                                             ScalarType type, RawLayout layout, SizeRule rule);
 

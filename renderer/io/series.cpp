@@ -95,31 +95,6 @@ class SeriesSource final : public VolumeSource {
   std::vector<SeriesStep> steps_;
 };
 
-// One step of steps stored back to back: a box reads from its own offset.
-// It mirrors raw_reader.cpp's RawVolumeSource, which only openRawVolume
-// makes, and that checks the data's size again for every step (for gzip, a
-// whole decode per step); openPackedSteps has checked all steps at once.
-class PackedStepSource final : public VolumeSource {
- public:
-  PackedStepSource(std::string name, const GridGeometry& grid, ScalarType type, RawLayout layout)
-      : name_(std::move(name)), grid_(grid), type_(type), layout_(std::move(layout)) {}
-
-  const GridGeometry& grid() const override { return grid_; }
-  ScalarType type() const override { return type_; }
-  bool canReadPartially() const override { return layout_.encoding == RawEncoding::kRaw; }
-  Brick readBox(const NodeBox& owned, const NodeBox& stored) const override {
-    checkReadBoxes(name_, grid_, owned, stored);
-    return readRawBox(layout_, grid_, type_, owned, stored);
-  }
-  std::string describe() const override { return name_ + ": " + shapeText(grid_, type_); }
-
- private:
-  std::string name_;
-  GridGeometry grid_;
-  ScalarType type_;
-  RawLayout layout_;
-};
-
 std::string realPathOf(const std::string& path) {
   char buf[PATH_MAX];
   return ::realpath(path.c_str(), buf) ? std::string(buf) : std::string();
@@ -302,7 +277,7 @@ std::vector<std::unique_ptr<VolumeSource>> openPackedSteps(const std::string& na
   for (std::int64_t k = 0; k < count; ++k) {
     RawLayout step = layout;
     step.offset = layout.offset + std::uint64_t(k) * stepBytes;
-    steps.push_back(std::make_unique<PackedStepSource>(name + " step " + std::to_string(k), grid, type, std::move(step)));
+    steps.push_back(rawVolumeSource(name + " step " + std::to_string(k), grid, type, std::move(step)));
   }
   return steps;
 }
