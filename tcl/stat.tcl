@@ -26,8 +26,8 @@
 
 namespace eval ::pvr::gui::stat {
     # Phases in stacking order (bottom first), with their colours.
-    variable phases {dist rend comp comm send}
-    variable colours {dist #8c6bb1 rend #2b8cbe comp #f16913 comm #41ab5d send #d7301f}
+    variable phases {read prep dist rend comp comm send}
+    variable colours {read #969696 prep #fdd0a2 dist #8c6bb1 rend #2b8cbe comp #f16913 comm #41ab5d send #d7301f}
     # Per canvas: the frames shown, {frame timingDict count} each, oldest
     # first; count numbers the frames received since attach or clear.
     variable frames
@@ -64,7 +64,7 @@ proc ::pvr::gui::stat::forget {w} {
 }
 
 # ::pvr::gui::stat::add --
-#   Appends frame `frame` with `timing` (dict: dist rend comp comm send, in
+#   Appends frame `frame` with `timing` (dict: read prep dist rend comp comm send, in
 #   seconds; arrival optional) and redraws.
 # Side effects: drops the oldest frame beyond maxFrames.
 proc ::pvr::gui::stat::add {w frame timing} {

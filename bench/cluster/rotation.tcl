@@ -6,7 +6,7 @@
 #
 # After one warm-up frame (the job has loaded its bricks), renders
 # `render rotate 0,0,1 0,N-1:N` and appends one CSV row per frame to FILE:
-# layout, run, frame, the ranks' phases dist rend comp comm send (seconds, as the
+# layout, run, frame, the ranks' phases read prep dist rend comp comm send (seconds, as the
 # collector reports them with the frame) and arrival (seconds from the
 # request to the frame). Prints one summary line: seconds per frame (the
 # last arrival over N) and the mean of each phase, and with -veth the bytes
@@ -21,7 +21,7 @@ if {[llength $unknown]} {
 }
 array set opt [dict merge $defaults $argv]
 set ::pvr::progress 0
-set phases {dist rend comp comm send}
+set phases {read prep dist rend comp comm send}
 
 pvr_session :bench
 :bench open $opt(-host) -ranks $opt(-ranks) -timeout 60
