@@ -1,13 +1,37 @@
 #include "brick.h"
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <new>
 
 #include "error.h"
 #include "preprocess.h"
 
 namespace pvr::core {
+
+namespace {
+constexpr std::size_t kHugePage = std::size_t(2) << 20;
+// Below this a brick's page faults do not matter.
+constexpr std::size_t kHugeStorage = std::size_t(64) << 20;
+}  // namespace
+
+void* Brick::allocateStorage(std::size_t bytes) {
+  if (bytes < kHugeStorage) return ::operator new(bytes);
+  void* p = ::operator new(bytes, std::align_val_t(kHugePage));
+  // Only advice: where transparent huge pages are off the brick keeps 4 KiB pages.
+  (void)::madvise(p, bytes, MADV_HUGEPAGE);
+  return p;
+}
+
+void Brick::freeStorage(void* p, std::size_t bytes) noexcept {
+  if (bytes < kHugeStorage)
+    ::operator delete(p);
+  else
+    ::operator delete(p, std::align_val_t(kHugePage));
+}
 
 Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored, Unwritten)
     : grid_(grid), type_(type), owned_(owned), stored_(stored) {
