@@ -17,7 +17,7 @@ plot "< grep '^batch,.*,cold,' ".csv using 2:5 with linespoints title "pvr-node 
      cold_mean with lines dashtype 2 title "cold sequential read", \
      warm_mean with lines dashtype 3 title "warm sequential read"
 set title "pvr-node --batch: phases (max over ranks)"
-unset logscale x; set style data histograms; set style histogram rowstacked; set style fill solid; set key outside
+unset logscale x; set style data histograms; set style histogram rowstacked; set style fill solid; set key outside; set xtics rotate by -45
 plot "< grep '^batch,' ".csv using 7:xtic(sprintf("%d %s", column(2), strcol(3))) title "start", \
      '' using 8 title "read", '' using 9 title "prep", '' using 10 title "dist", '' using 11 title "rend", \
      '' using 12 title "comp", '' using 13 title "comm", '' using 14 title "send", '' using 15 title "write" linecolor rgb "gray40"
