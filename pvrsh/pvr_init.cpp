@@ -38,6 +38,10 @@ extern "C" __attribute__((visibility("default"))) int Pvr_Init(Tcl_Interp* inter
   // print progress and a timing table on stderr.
   if (Tcl_Eval(interp, "namespace eval ::pvr { if {![info exists progress]} { variable progress 0 } }") != TCL_OK)
     return TCL_ERROR;
+  // ::pvr::phases: the phases of every timing dict, in order, for graphs
+  // and tables written in Tcl.
+  if (!Tcl_SetVar2Ex(interp, "::pvr::phases", nullptr, pvr::tcl::phaseNames(), TCL_GLOBAL_ONLY | TCL_LEAVE_ERR_MSG))
+    return TCL_ERROR;
   Tcl_CreateObjCommand(interp, "pvr_session", pvr::tcl::sessionCreateCmd, nullptr, nullptr);
   return Tcl_PkgProvide(interp, "pvr", PVR_PACKAGE_VERSION);
 }

@@ -26,6 +26,12 @@ constexpr Phase kPhases[] = {{"read", &proto::FrameTiming::read},       {"prep",
 
 }  // namespace
 
+Tcl_Obj* phaseNames() {
+  Tcl_Obj* list = Tcl_NewListObj(0, nullptr);
+  for (const Phase& p : kPhases) Tcl_ListObjAppendElement(nullptr, list, Tcl_NewStringObj(p.name, -1));
+  return list;
+}
+
 bool progressOn(Tcl_Interp* interp) {
   const char* v = Tcl_GetVar2(interp, "::pvr::progress", nullptr, TCL_GLOBAL_ONLY);
   int on = 0;

@@ -176,6 +176,9 @@ inline double seconds(Clock::duration d) { return std::chrono::duration<double>(
 
 // One frame's timing as the Tcl dict the image callback and `timing` give.
 Tcl_Obj* timingDict(const FrameRecord& record);
+// The phases of a timing dict in FrameTiming's order ({read prep dist rend
+// comp comm send}); package pvr publishes it as ::pvr::phases.
+Tcl_Obj* phaseNames();
 
 // True when ::pvr::progress is set: sequences print progress and a timing
 // table on stderr (pvrsh sets it when it runs a script).

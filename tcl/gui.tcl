@@ -6,7 +6,7 @@
 #   .       image view (drag to rotate), connection, dataset, image size,
 #           view buttons, rotation sequences, transfer-function editor,
 #           a time slider for a series dataset, progress bar and status line
-#   .stat   per-frame times, dist/rend/comp/comm/send (stat.tcl)
+#   .stat   per-frame times, one bar part per phase of ::pvr::phases (stat.tcl)
 #   .layout cluster and group configuration (gui_layout.tcl)
 #
 # One session, :pvrgui. Frames go into the photo ::pvr::gui::image through

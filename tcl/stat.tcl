@@ -24,9 +24,11 @@
 # Figure 5's `:brain image callback imgCallback` works as written: the global
 # imgCallback below feeds the canvas .c.c when it exists.
 
+package require pvr
+
 namespace eval ::pvr::gui::stat {
-    # Phases in stacking order (bottom first), with their colours.
-    variable phases {read prep dist rend comp comm send}
+    # Phases in stacking order (bottom first): package pvr's list; their colours.
+    variable phases $::pvr::phases
     variable colours {read #969696 prep #fdd0a2 dist #8c6bb1 rend #2b8cbe comp #f16913 comm #41ab5d send #d7301f}
     # Per canvas: the frames shown, {frame timingDict count} each, oldest
     # first; count numbers the frames received since attach or clear.

@@ -21,7 +21,7 @@ if {[llength $unknown]} {
 }
 array set opt [dict merge $defaults $argv]
 set ::pvr::progress 0
-set phases {read prep dist rend comp comm send}
+set phases $::pvr::phases
 
 pvr_session :bench
 :bench open $opt(-host) -ranks $opt(-ranks) -timeout 60

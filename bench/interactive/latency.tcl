@@ -101,7 +101,7 @@ proc percentile {values p} {
 set photo {}
 set shown {}
 set overhead {}
-set phases {read prep dist rend comp comm send}
+set phases $::pvr::phases
 foreach p $phases {
     set sum($p) 0.0
 }

@@ -29,7 +29,7 @@ if {[llength $unknown]} {
 }
 array set opt [dict merge $defaults $argv]
 set ::pvr::progress 0
-set phases {read prep dist rend comp comm send}
+set phases $::pvr::phases
 
 # pvrNodePeaks: the peak RSS (MB) of every pvr-node descending from pid
 # `root`, in pid order (ranks start in rank order).

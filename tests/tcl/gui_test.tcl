@@ -336,10 +336,11 @@ check "sequence: the status line reports it" {[string match "sequence done: 6 fr
     $::pvr::gui::statusText
 set timing [lindex [::pvr::gui::stat::frames .stat.c] end 1]
 set phases 0
-foreach k {dist rend comp comm send} {
+foreach k $::pvr::phases {
     incr phases [dict exists $timing $k]
 }
-check "graph: the frame's timing has the five phases" {$phases == 5} $timing
+check "graph: the frame's timing has every phase of ::pvr::phases" \
+    {$phases == [llength $::pvr::phases] && $phases == 7} $timing
 
 # ---- Step 9: the cluster and group window ----
 ::pvr::gui::layout::show $::pvr::gui::session
