@@ -243,6 +243,11 @@ TEST_CASE("a host Open MPI lost contact with is named in the job's end text") {
       "This is usually due to either a failure of the TCP network\n";
   CHECK(lostHostFromMpirunOutput(lostDaemon) == "h2");
   CHECK(lostHostFromMpirunOutput("  Local host: h1\n  Peer host:  h3\n") == "h3");
+  // A rank that cannot reach the lost host's ranks names its address; the
+  // resolver turns it into a name where it can (here the hosts file's
+  // 127.0.0.1), and an address nobody names stays an address.
+  CHECK(lostHostFromMpirunOutput("  Local host: h3\n  Message:    connect() to 127.0.0.1:1024 failed\n") == "localhost");
+  CHECK(lostHostFromMpirunOutput("  Message:    connect() to 192.0.2.77:1024 failed\n") == "192.0.2.77");
   CHECK(lostHostFromMpirunOutput("mpirun noticed that process rank 1 with PID 4242 on node x exited") == "");
   const std::string text = mpirunEndText("mpirun exited with status 1", lostDaemon);
   CHECK_THAT(text, Catch::StartsWith("host h2 was lost"));
