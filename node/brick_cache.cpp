@@ -1,5 +1,8 @@
 #include "brick_cache.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 
@@ -101,6 +104,9 @@ void BrickCache::readAhead(std::vector<int> steps) {
 }
 
 void BrickCache::readAheadLoop() {
+  // Reading ahead fills the time the render leaves idle; where the cores
+  // are all rendering it yields to the render threads.
+  (void)::setpriority(PRIO_PROCESS, ::gettid(), 10);
   std::unique_lock lock(mutex_);
   while (!stop_ && !queued_.empty()) {
     const int step = queued_.front();
