@@ -1,10 +1,8 @@
 #include "mpirun_launcher.h"
 
-#include <arpa/inet.h>
 #include <netdb.h>
 #include <sys/socket.h>
 
-#include <cstring>
 #include <regex>
 
 #include "pvr_protocol.h"
@@ -17,23 +15,14 @@ constexpr std::size_t kTailInText = 600;
 // The name the resolver gives an IPv4 or IPv6 address (the hosts file of a
 // cluster names its nodes), or the address itself.
 std::string hostNameOf(const std::string& address) {
-  sockaddr_storage storage{};
-  socklen_t length = 0;
-  auto* v4 = reinterpret_cast<sockaddr_in*>(&storage);
-  auto* v6 = reinterpret_cast<sockaddr_in6*>(&storage);
-  if (::inet_pton(AF_INET, address.c_str(), &v4->sin_addr) == 1) {
-    v4->sin_family = AF_INET;
-    length = sizeof *v4;
-  } else if (::inet_pton(AF_INET6, address.c_str(), &v6->sin6_addr) == 1) {
-    v6->sin6_family = AF_INET6;
-    length = sizeof *v6;
-  } else {
-    return address;
-  }
+  addrinfo hints{};
+  hints.ai_flags = AI_NUMERICHOST;  // an address, never a lookup by name
+  addrinfo* found = nullptr;
+  if (::getaddrinfo(address.c_str(), nullptr, &hints, &found) != 0) return address;
   char name[NI_MAXHOST];
-  if (::getnameinfo(reinterpret_cast<sockaddr*>(&storage), length, name, sizeof name, nullptr, 0, NI_NAMEREQD) != 0)
-    return address;
-  return name;
+  const int rc = ::getnameinfo(found->ai_addr, found->ai_addrlen, name, sizeof name, nullptr, 0, NI_NAMEREQD);
+  ::freeaddrinfo(found);
+  return rc == 0 ? std::string(name) : address;
 }
 
 class MpirunLauncher final : public Launcher {
