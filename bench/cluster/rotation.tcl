@@ -14,12 +14,8 @@
 # share the machine's /sys, so its counters are readable from h0).
 set defaults {-host "" -tag "" -run 1 -csv "" -ranks 2 -frames 36 -size 512 -preset "" -veth ""
               -dataset ct_head_cranium/ct_head_cranium.json}
-set unknown [lmap k [dict keys $argv] {expr {[dict exists $defaults $k] ? [continue] : $k}}]
-if {[llength $unknown]} {
-    puts stderr "rotation.tcl: unknown options $unknown (known: [dict keys $defaults])"
-    exit 2
-}
-array set opt [dict merge $defaults $argv]
+source [file join [file dirname [info script]] .. lib options.tcl]
+benchOptions rotation.tcl $defaults $argv
 set ::pvr::progress 0
 set phases $::pvr::phases
 

@@ -22,12 +22,8 @@
 # every pvr-node under pvrd PID, read before `close`, in pid order.
 set defaults {-host "" -pvrd 0 -dataset "" -csv "" -kind pvrsh -cache warm -ranks 8 -size 512 -settings ""
               -frames 20 -readfile "" -voxels 0 -series 0 -cachemem ""}
-set unknown [lmap k [dict keys $argv] {expr {[dict exists $defaults $k] ? [continue] : $k}}]
-if {[llength $unknown]} {
-    puts stderr "session.tcl: unknown options $unknown (known: [dict keys $defaults])"
-    exit 2
-}
-array set opt [dict merge $defaults $argv]
+source [file join [file dirname [info script]] .. lib options.tcl]
+benchOptions session.tcl $defaults $argv
 set ::pvr::progress 0
 set phases $::pvr::phases
 
