@@ -40,7 +40,7 @@ void prepareCacheRank(NodeState& state) {
                       stored = core::storedBox(tree, i, state.ghost)](int step) {
         return source->step(step).readBox(owned, stored);
       });
-      s.shown = state.scene.volume.timestep;
+      s.shown = state.scene.volumes.front().source.timestep;
       keys.push_back({c, i});
     }
   }

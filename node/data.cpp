@@ -96,7 +96,7 @@ void collectFailure(NodeState& state, const std::function<void()>& phase) {
 // The one rule for a step number (core::checkTimestep), for a step the
 // session shows other than the scene's own (render time).
 void checkStep(const NodeState& state, int step) {
-  core::VolumeSpec spec = state.scene.volume;
+  core::VolumeSpec spec = state.scene.volumes.front().source;
   spec.timestep = step;
   core::checkTimestep(spec, *state.source);
 }
@@ -105,15 +105,15 @@ void checkStep(const NodeState& state, int step) {
 
 Reload openScene(NodeState& state, const std::string& sceneJson) {
   core::Scene scene = core::parseScene(nlohmann::json::parse(sceneJson), state.dataDir);
-  const std::string key = volumeKeyOf(scene.volume);
+  const std::string key = volumeKeyOf(scene.volumes.front().source);
   const bool changed = key != state.volumeKey || !state.source;
   std::unique_ptr<core::VolumeSource> source;
   const core::VolumeSource* grid = state.source.get();
   if (changed) {
-    source = core::openSceneVolume(scene.volume);
+    source = core::openSceneVolume(scene.volumes.front().source);
     grid = source.get();
   }
-  core::checkTimestep(scene.volume, *grid);
+  core::checkTimestep(scene.volumes.front().source, *grid);
   core::resolveDefaults(scene, grid->grid());
   const core::RenderOptions options = core::renderOptionsFor(scene);
   const int ghost = core::ghostLayers(grid->grid(), options);
@@ -123,7 +123,7 @@ Reload openScene(NodeState& state, const std::string& sceneJson) {
     state.source = std::move(source);
     state.volumeKey = key;
   }
-  const bool stepChanged = scene.volume.timestep != state.scene.volume.timestep;
+  const bool stepChanged = scene.volumes.front().source.timestep != state.scene.volumes.front().source.timestep;
   state.scene = scene;
   state.renderOptions = options;
   const bool ghostChanged = ghost != state.ghost;
@@ -145,7 +145,7 @@ void loadBricks(NodeState& state) {
 
 void loadStep(NodeState& state) {
   collectFailure(state, [&] {
-    const int step = state.scene.volume.timestep;
+    const int step = state.scene.volumes.front().source.timestep;
     showStep(state, step);
     if (const ClusterPlan* me = state.myCluster(); me && me->role == proto::ClusterRole::kCache)
       for (int c : me->serves) serveStep(state, c, step, {});
@@ -155,7 +155,7 @@ void loadStep(NodeState& state) {
 void distributeData(NodeState& state) {
   prepareCacheRank(state);
   if (!state.renders() || !state.source) return;
-  distributeStep(state, state.scene.volume.timestep);
+  distributeStep(state, state.scene.volumes.front().source.timestep);
 }
 
 void showStep(NodeState& state, int step) {
@@ -182,7 +182,7 @@ void showStep(NodeState& state, int step) {
 }
 
 void classify(NodeState& state) {
-  if (state.current) state.current->renderer->classify(state.scene.transfer, state.renderOptions, state.pool.get());
+  if (state.current) state.current->renderer->classify(state.scene.volumes.front().transfer, state.renderOptions, state.pool.get());
 }
 
 void rebalanceIfNeeded(NodeState& state) {
@@ -194,7 +194,7 @@ void rebalanceIfNeeded(NodeState& state) {
   core::ContentGrid content;
   std::uint64_t mine = 0;
   comm::runAgreed(cluster, [&] {
-    const core::TransferTable table(state.scene.transfer, state.scene.sampling.step);
+    const core::TransferTable table(state.scene.volumes.front().transfer, state.scene.sampling.step);
     content = core::countContent(state.current->brick, table, {8, 8, 8}, state.pool.get());
     mine = core::totalContent(content);
   });

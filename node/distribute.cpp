@@ -102,7 +102,7 @@ Distribution distributeBricks(const core::VolumeSource& source, const core::Scen
     // every rank builds the same balanced tree and fetches its new brick.
     core::ContentGrid content;
     runAgreed(comm, [&] {
-      const core::TransferTable table(scene.transfer, scene.sampling.step);
+      const core::TransferTable table(scene.volumes.front().transfer, scene.sampling.step);
       content = core::countContent(out.brick, table);
     });
     comm.allReduceSum(content.counts);

@@ -79,7 +79,7 @@ PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& optio
   core::RenderOptions renderOptions;
   runAgreed(comm, [&] {
     composite::makeStrategy(options.strategy, options.strategyParams);
-    source = options.openVolume ? options.openVolume(sceneIn.volume) : core::openSceneVolume(sceneIn.volume);
+    source = options.openVolume ? options.openVolume(sceneIn.volumes.front().source) : core::openSceneVolume(sceneIn.volumes.front().source);
     result.scene = sceneIn;
     core::resolveDefaults(result.scene, source->grid());
     if (options.earlyTermination) {
@@ -110,7 +110,7 @@ PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& optio
     core::ThreadPool pool(options.threads);
     const auto prepStart = std::chrono::steady_clock::now();
     core::BrickRenderer renderer(prepared.bricks.brick, &pool);
-    renderer.classify(result.scene.transfer, renderOptions, &pool);
+    renderer.classify(result.scene.volumes.front().transfer, renderOptions, &pool);
     report.prep = loaded.preprocess + secondsSince(prepStart);
     const auto start = std::chrono::steady_clock::now();
     prepared.partial = renderer.render(*prepared.camera, renderOptions, pool);

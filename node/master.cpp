@@ -86,7 +86,7 @@ void Master::on(const proto::StatusRequest&, std::uint32_t id) {
 void Master::on(const proto::RenderFrame&, std::uint32_t id) {
   requireDataset(state_);
   const core::CameraSpec camera = state_.scene.camera;
-  const int step = state_.scene.volume.timestep;
+  const int step = state_.scene.volumes.front().source.timestep;
   renderSequence(1, [&](int) { return camera; }, [&](int) { return step; }, id);
 }
 
@@ -94,7 +94,7 @@ void Master::on(const proto::RenderFrame&, std::uint32_t id) {
 void Master::on(const proto::RenderRotation& m, std::uint32_t id) {
   const Rotation rotation(state_.scene.camera, m);
   requireDataset(state_);
-  const int step = state_.scene.volume.timestep;
+  const int step = state_.scene.volumes.front().source.timestep;
   renderSequence(rotation.frames(), [&](int k) { return rotation.camera(k); }, [&](int) { return step; }, id);
 }
 

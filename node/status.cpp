@@ -67,7 +67,7 @@ void addDataset(const NodeState& state, std::vector<proto::KeyValue>& out) {
   out.push_back({"bounds", list({lo.x, lo.y, lo.z, hi.x, hi.y, hi.z})});
   if (state.valueRange) out.push_back({"value_range", list({(*state.valueRange)[0], (*state.valueRange)[1]})});
   std::string points;
-  for (const core::TransferPoint& p : state.scene.transfer.points)
+  for (const core::TransferPoint& p : state.scene.volumes.front().transfer.points)
     append(points, list({p.scalar, p.r, p.g, p.b, p.opacity}));
   out.push_back({"transfer_function", points});
 }
@@ -115,7 +115,7 @@ std::string cacheText(const NodeState& state, const RuntimeSettings& settings) {
 // The time steps of the dataset and the one shown.
 void addTimeSteps(const NodeState& state, const RuntimeSettings& settings, std::vector<proto::KeyValue>& out) {
   const core::VolumeSource& source = *state.source;
-  out.push_back({"timestep", std::to_string(state.scene.volume.timestep)});
+  out.push_back({"timestep", std::to_string(state.scene.volumes.front().source.timestep)});
   out.push_back({"timesteps", std::to_string(source.steps())});
   std::string times;
   for (int k = 0; k < source.steps(); ++k) append(times, number(source.stepTime(k)));

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,10 +22,11 @@
 namespace pvr::core {
 
 struct VolumeSpec {
-  std::string file;        // a volume file (any registered format); or
-  std::string procedural;  // a procedural volume name with
-  IVec3 dims{64, 64, 64};  // its resolution
-  std::optional<Vec3> spacing;  // procedural only: overrides the default isotropic spacing
+  std::string file;         // a volume file (any registered format); or
+  std::string procedural;   // a procedural volume name; or
+  std::string computation;  // a user computation's name (node/computations/), run on the ranks;
+  IVec3 dims{64, 64, 64};   // procedural and computation: the resolution
+  std::optional<Vec3> spacing;  // procedural and computation: overrides the default isotropic spacing
   int timestep = 0;             // 0-based step of a time series (the scene's "timestep")
 };
 
@@ -89,9 +91,21 @@ struct ShadingSpec {
   Vec3 lightDirection{0, 0, 1};
 };
 
-struct Scene {
-  VolumeSpec volume;
+// One volume of a scene: its data, its transfer function, whether it shows.
+struct SceneVolume {
+  std::string name = "volume";  // unique in the scene; the single "volume" form's is "volume"
+  VolumeSpec source;
   TransferFunctionSpec transfer;
+  bool visible = true;
+};
+
+struct Scene {
+  // At least one. Each keeps its own grid and transfer function; where they
+  // overlap their media mix (docs/scene.md, "Several volumes"). Code that
+  // renders one volume only takes the first.
+  std::vector<SceneVolume> volumes{1};
+  // Steering parameters of a computation volume, by name ("parameters").
+  std::map<std::string, double> parameters;
   CameraSpec camera;
   ImageSpec image;
   SamplingSpec sampling;

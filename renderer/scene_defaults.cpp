@@ -39,7 +39,8 @@ CameraSpec automaticCamera(const GridGeometry& grid, int width, int height) {
 void resolveDefaults(Scene& scene, const GridGeometry& grid) {
   grid.validate("volume");
   const double voxel = grid.minSpacing();
-  if (scene.transfer.unitDistance == 0) scene.transfer.unitDistance = voxel;
+  for (SceneVolume& v : scene.volumes)
+    if (v.transfer.unitDistance == 0) v.transfer.unitDistance = voxel;
   if (scene.sampling.step == 0) scene.sampling.step = 0.5 * voxel;
   if (scene.camera.automatic) scene.camera = automaticCamera(grid, scene.image.width, scene.image.height);
 }

@@ -14,8 +14,10 @@
 
 namespace pvr::core {
 
-// "volume": relative file paths resolve against baseDir.
-VolumeSpec parseVolume(const nlohmann::json& section, const std::string& baseDir);
+// "volume" (or the volume keys of a "volumes" entry at `path`): relative
+// file paths resolve against baseDir.
+VolumeSpec parseVolume(const nlohmann::json& section, const std::string& baseDir,
+                       const std::string& path = "volume");
 nlohmann::json volumeToJson(const VolumeSpec& volume);
 
 // "timestep": a 0-based step of a time series, 0..INT32_MAX. Whether the
@@ -25,9 +27,19 @@ int parseTimestep(const nlohmann::json& value);
 
 // "transfer_function": points, a ParaView preset file (relative to baseDir)
 // or an inline preset; defaultTransfer() is the scene without the section.
-TransferFunctionSpec parseTransfer(const nlohmann::json& section, const std::string& baseDir);
+TransferFunctionSpec parseTransfer(const nlohmann::json& section, const std::string& baseDir,
+                                   const std::string& path = "transfer_function");
 TransferFunctionSpec defaultTransfer();
 nlohmann::json transferToJson(const TransferFunctionSpec& transfer);
+
+// "volumes": several named volumes, each with its transfer function
+// (docs/scene.md, "Several volumes"); and the single-volume form
+// ("volume" + "transfer_function") they generalise.
+std::vector<SceneVolume> parseVolumes(const nlohmann::json& section, const std::string& baseDir);
+nlohmann::json volumesToJson(const std::vector<SceneVolume>& volumes);
+
+// "parameters": steering parameters, name -> finite number.
+std::map<std::string, double> parseParameters(const nlohmann::json& section);
 
 // "image", "sampling", "shading": how to render.
 ImageSpec parseImage(const nlohmann::json& section);

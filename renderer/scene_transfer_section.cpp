@@ -46,8 +46,7 @@ TransferFunctionSpec presetFile(const json& v, const std::string& path, const st
 
 }  // namespace
 
-TransferFunctionSpec parseTransfer(const json& v, const std::string& baseDir) {
-  const std::string path = "transfer_function";
+TransferFunctionSpec parseTransfer(const json& v, const std::string& baseDir, const std::string& path) {
   requireObject(v, path, {"points", "paraview_preset", "paraview", "unit_distance"});
   const std::string form = exactlyOneOf(v, path, {"points", "paraview_preset", "paraview"},
                                         "'points', 'paraview_preset' (a preset file) or 'paraview' (a preset inline)");

@@ -5,6 +5,10 @@
 namespace pvr::core {
 
 std::unique_ptr<VolumeSource> openSceneVolume(const VolumeSpec& spec) {
+  if (!spec.computation.empty())
+    throw Error(ErrorCode::kInvalidArgument, "volume.computation '" + spec.computation +
+                                                 "': a computation runs on the ranks of a pvr-node session "
+                                                 "(docs/steering.md), not from a file or a generator");
   std::unique_ptr<VolumeSource> source;
   if (!spec.file.empty()) source = openVolumeFile(spec.file);
   else if (spec.spacing) source = openProcedural(spec.procedural, spec.dims, *spec.spacing);

@@ -10,6 +10,7 @@
 namespace pvr::core {
 
 // Opens the volume and checks spec.timestep against it (checkTimestep).
+// A computation volume is not opened here: it runs on the ranks (node/computations/).
 // Throws pvr::Error naming the file or procedural volume.
 std::unique_ptr<VolumeSource> openSceneVolume(const VolumeSpec& spec);
 

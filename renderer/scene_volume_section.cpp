@@ -1,5 +1,6 @@
-// The scene's "volume" section: a volume file or a procedural volume; and
-// the top-level "timestep", the step of a time-series volume to render.
+// A volume of the scene (the "volume" section, or one entry of "volumes"): a
+// volume file, a procedural volume or a user computation; and the top-level
+// "timestep", the step of a time-series volume to render.
 #include <algorithm>
 
 #include "io/volume_io.h"
@@ -10,25 +11,32 @@ namespace pvr::core {
 
 using namespace scene_json;
 
-VolumeSpec parseVolume(const json& v, const std::string& baseDir) {
-  const std::string path = "volume";
-  requireObject(v, path, {"file", "procedural", "dims", "spacing"});
+VolumeSpec parseVolume(const json& v, const std::string& baseDir, const std::string& path) {
+  requireObject(v, path, {"file", "procedural", "computation", "dims", "spacing"});
   VolumeSpec spec;
-  if (exactlyOneOf(v, path, {"file", "procedural"},
-                   "'file' (a volume file) or 'procedural' (a generated volume)") == "file") {
+  const std::string form = exactlyOneOf(v, path, {"file", "procedural", "computation"},
+                                        "'file' (a volume file), 'procedural' (a generated volume) or "
+                                        "'computation' (a user computation on the ranks)");
+  if (form == "file") {
     for (const char* key : {"dims", "spacing"})
-      if (find(v, key)) fail(childPath(path, key), "only for a procedural volume (a file carries its own)");
+      if (find(v, key)) fail(childPath(path, key), "only for a procedural or computation volume (a file carries its own)");
     spec.file = asString(v["file"], path + ".file");
     if (spec.file.empty()) fail(path + ".file", "must not be empty");
     spec.file = resolvePath(spec.file, baseDir);
     return spec;
   }
 
-  spec.procedural = asString(v["procedural"], path + ".procedural");
-  const std::vector<std::string> names = proceduralNames();
-  if (std::find(names.begin(), names.end(), spec.procedural) == names.end())
-    fail(path + ".procedural",
-         "unknown procedural volume '" + spec.procedural + "' (known: " + joinNames(names) + ")");
+  if (form == "procedural") {
+    spec.procedural = asString(v["procedural"], path + ".procedural");
+    const std::vector<std::string> names = proceduralNames();
+    if (std::find(names.begin(), names.end(), spec.procedural) == names.end())
+      fail(path + ".procedural",
+           "unknown procedural volume '" + spec.procedural + "' (known: " + joinNames(names) + ")");
+  } else {
+    // Which computations exist is the ranks' registry's to say (node/computations/).
+    spec.computation = asString(v["computation"], path + ".computation");
+    if (spec.computation.empty()) fail(path + ".computation", "must not be empty");
+  }
   if (const json* dims = find(v, "dims")) {
     const std::string p = path + ".dims";
     if (!dims->is_array() || dims->size() != 3)
@@ -59,8 +67,9 @@ int parseTimestep(const json& v) {
 
 json volumeToJson(const VolumeSpec& volume) {
   if (!volume.file.empty()) return {{"file", volume.file}};
-  json out = {{"procedural", volume.procedural},
-              {"dims", json::array({volume.dims.x, volume.dims.y, volume.dims.z})}};
+  json out = {{"dims", json::array({volume.dims.x, volume.dims.y, volume.dims.z})}};
+  if (!volume.computation.empty()) out["computation"] = volume.computation;
+  else out["procedural"] = volume.procedural;
   if (volume.spacing) out["spacing"] = toJson(*volume.spacing);
   return out;
 }

@@ -88,16 +88,16 @@ int main(int argc, char** argv) {
     if (args.width > 0) scene.image.width = args.width, scene.image.height = args.height;
     if (args.preintegrated >= 0) scene.sampling.preintegrated = args.preintegrated == 1;
 
-    const auto source = openSceneVolume(scene.volume);
+    const auto source = openSceneVolume(scene.volumes.front().source);
     resolveDefaults(scene, source->grid());
     // The scene's time step of a series (step 0, the volume itself, otherwise).
-    const Brick volume = source->step(scene.volume.timestep).readAll();
+    const Brick volume = source->step(scene.volumes.front().source.timestep).readAll();
 
     RenderOptions options = renderOptionsFor(scene);
     if (args.skip >= 0) options.skipEmpty = args.skip == 1;
     ThreadPool pool(args.threads);
     BrickRenderer renderer(volume);
-    renderer.classify(scene.transfer, options);
+    renderer.classify(scene.volumes.front().transfer, options);
     const Camera camera(scene.camera, scene.image.width, scene.image.height);
 
     Image image;

@@ -86,7 +86,7 @@ void selfCheck(const core::ReferenceVolume& volume, const core::Scene& s,
     const int y = int(r) * kEvery + kEvery / 2;
     if (y >= camera.height()) return;
     for (int x = kEvery / 2; x < camera.width(); x += kEvery) {
-      const core::RgbaD f = core::integrateRay(volume, s.transfer, camera.ray(x, y), light, fine);
+      const core::RgbaD f = core::integrateRay(volume, s.volumes.front().transfer, camera.ray(x, y), light, fine);
       const core::Rgba c = image.at(x, y);
       for (double d : {f.r - c.r, f.g - c.g, f.b - c.b, f.a - c.a}) {
         rowMax[r] = std::max(rowMax[r], std::abs(d));
@@ -135,12 +135,12 @@ void writeCached(const std::string& stem, const Reference& ref) {
 
 std::optional<std::string> missingVolume(const std::string& scenePath) {
   const core::Scene scene = core::loadSceneFile(scenePath);
-  if (scene.volume.file.empty() || fs::exists(scene.volume.file)) return std::nullopt;
-  return scene.volume.file + " is missing";
+  if (scene.volumes.front().source.file.empty() || fs::exists(scene.volumes.front().source.file)) return std::nullopt;
+  return scene.volumes.front().source.file + " is missing";
 }
 
 BenchScene::BenchScene(const std::string& path) : path_(path), scene_(core::loadSceneFile(path)) {
-  source_ = core::openSceneVolume(scene_.volume);
+  source_ = core::openSceneVolume(scene_.volumes.front().source);
   core::resolveDefaults(scene_, source_->grid());
   volume_ = source_->readAll();
 }
@@ -177,7 +177,7 @@ Reference computeReference(const BenchScene& scene, const ReferenceSettings& set
   core::ReferenceOptions options;
   options.step = ref.dt;
   options.shading = s.shading;
-  ref.image = core::renderReference(volume, s.transfer, camera, options, pool);
+  ref.image = core::renderReference(volume, s.volumes.front().transfer, camera, options, pool);
   ref.seconds = secondsSince(started);
   selfCheck(volume, s, camera, options, ref.image, ref, pool);
 
@@ -219,7 +219,7 @@ CaseResult measureCase(const BenchScene& scene, const Case& c, const Reference& 
   options.preintegrated = c.preintegrated;
   options.skipEmpty = c.skipEmpty;
   core::BrickRenderer renderer(scene.volume());
-  renderer.classify(s.transfer, options);
+  renderer.classify(s.volumes.front().transfer, options);
 
   // Error at the reference's size and view (this render also warms the caches).
   const core::Camera small(s.camera, reference.size.width, reference.size.height);

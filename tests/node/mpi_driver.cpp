@@ -112,12 +112,12 @@ std::vector<View> views(const GridGeometry& grid) {
 
 Scene sceneFor(const std::string& volumeFile, const CameraSpec& camera, bool dense) {
   Scene s;
-  s.volume.file = volumeFile;
+  s.volumes.front().source.file = volumeFile;
   // A dense volume shows every voxel; otherwise bands with empty space between.
   if (dense)
-    s.transfer.points = {{0, 0.2, 0.4, 0.9, 0.06}, {1, 1.0, 0.9, 0.6, 0.5}};
+    s.volumes.front().transfer.points = {{0, 0.2, 0.4, 0.9, 0.06}, {1, 1.0, 0.9, 0.6, 0.5}};
   else
-    s.transfer.points = {{0.0, 0, 0, 0, 0},        {0.45, 0.2, 0.5, 1, 0},  {0.55, 0.3, 0.6, 1, 0.4},
+    s.volumes.front().transfer.points = {{0.0, 0, 0, 0, 0},        {0.45, 0.2, 0.5, 1, 0},  {0.55, 0.3, 0.6, 1, 0.4},
                          {0.65, 1, 0.7, 0.2, 0.0}, {0.8, 1, 0.7, 0.2, 0.0}, {0.9, 1, 0.3, 0.2, 0.8}};
   s.camera = camera;
   s.image.width = 56;
@@ -128,13 +128,13 @@ Scene sceneFor(const std::string& volumeFile, const CameraSpec& camera, bool den
 
 // The single-process render: what pvr-render does.
 Image renderSerial(Scene scene) {
-  const auto source = openSceneVolume(scene.volume);
+  const auto source = openSceneVolume(scene.volumes.front().source);
   resolveDefaults(scene, source->grid());
   const Brick volume = source->readAll();
   const RenderOptions options = renderOptionsFor(scene);
   ThreadPool pool(1);
   BrickRenderer renderer(volume);
-  renderer.classify(scene.transfer, options);
+  renderer.classify(scene.volumes.front().transfer, options);
   return renderer.render(Camera(scene.camera, scene.image.width, scene.image.height), options, pool);
 }
 

@@ -275,7 +275,7 @@ class Reference {
     brick_ = source_->readAll();
     renderer_ = std::make_unique<core::BrickRenderer>(brick_);
     options_ = core::renderOptionsFor(scene_);
-    renderer_->classify(scene_.transfer, options_);
+    renderer_->classify(scene_.volumes.front().transfer, options_);
   }
   const core::Scene& scene() const { return scene_; }
   const core::ValueRange& valueRange() const { return brick_.valueRange(); }
@@ -700,7 +700,7 @@ TEST_CASE_METHOD(Fixture, "scene patches are checked whole before and after the 
   CHECK(numbers(status["bounds"]) == std::vector<double>{0, 0, 0, kDims[0] - 1, kDims[1] - 1, (kDims[2] - 1) * 1.25});
   CHECK(numbers(status["value_range"]) == std::vector{ref.valueRange().min, ref.valueRange().max});
   std::vector<double> points;
-  for (const auto& p : scene.transfer.points) points.insert(points.end(), {p.scalar, p.r, p.g, p.b, p.opacity});
+  for (const auto& p : scene.volumes.front().transfer.points) points.insert(points.end(), {p.scalar, p.r, p.g, p.b, p.opacity});
   CHECK(points.size() == 20);
   CHECK(numbers(status["transfer_function"]) == points);
   CHECK(job.close());

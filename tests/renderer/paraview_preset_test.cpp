@@ -28,12 +28,12 @@ json sceneWithTransfer(const json& transfer) {
 // The transfer function of a scene naming `presetText` through a file in `dir`.
 TransferFunctionSpec throughFile(const std::string& presetText, const fs::path& dir, const std::string& name) {
   writeText(dir / name, presetText);
-  return parseScene(sceneWithTransfer({{"paraview_preset", name}}), dir.string()).transfer;
+  return parseScene(sceneWithTransfer({{"paraview_preset", name}}), dir.string()).volumes.front().transfer;
 }
 
 // The same preset inline.
 TransferFunctionSpec inlined(const std::string& presetText) {
-  return parseScene(sceneWithTransfer({{"paraview", json::parse(presetText)}}), "").transfer;
+  return parseScene(sceneWithTransfer({{"paraview", json::parse(presetText)}}), "").volumes.front().transfer;
 }
 
 void requireSameTransfer(const TransferFunctionSpec& a, const TransferFunctionSpec& b) {
@@ -134,13 +134,13 @@ TEST_CASE("inline and file presets give identical transfer functions", "[scene][
       sceneWithTransfer({{"paraview_preset", "presets/ct_bone.json"}, {"unit_distance", 0.957031}}),
       (kSourceRoot / "examples").string());
   const Scene viaInline = parseScene(sceneWithTransfer({{"paraview", bone}, {"unit_distance", 0.957031}}), "");
-  requireSameTransfer(viaFile.transfer, viaInline.transfer);
-  CHECK(viaInline.transfer.unitDistance == 0.957031);
-  REQUIRE(viaInline.transfer.points.size() == 5);
-  CHECK(viaInline.transfer.points.front().scalar == -1024);
-  CHECK(viaInline.transfer.points[1].opacity == 0);  // HU 200: still transparent
-  CHECK(viaInline.transfer.points.back().scalar == 2000);
-  CHECK(viaInline.transfer.points.back().opacity == 0.9);
+  requireSameTransfer(viaFile.volumes.front().transfer, viaInline.volumes.front().transfer);
+  CHECK(viaInline.volumes.front().transfer.unitDistance == 0.957031);
+  REQUIRE(viaInline.volumes.front().transfer.points.size() == 5);
+  CHECK(viaInline.volumes.front().transfer.points.front().scalar == -1024);
+  CHECK(viaInline.volumes.front().transfer.points[1].opacity == 0);  // HU 200: still transparent
+  CHECK(viaInline.volumes.front().transfer.points.back().scalar == 2000);
+  CHECK(viaInline.volumes.front().transfer.points.back().opacity == 0.9);
 }
 
 TEST_CASE("a malformed preset is an error naming the key path, inline and in a file", "[scene][preset]") {

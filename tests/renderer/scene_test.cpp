@@ -69,21 +69,21 @@ void requireSameVec(Vec3 a, Vec3 b) {
 // Field by field, exact: a printer that forgot a key fails here even when
 // printing twice agrees with itself.
 void requireSameScene(const Scene& a, const Scene& b) {
-  CHECK(a.volume.file == b.volume.file);
-  CHECK(a.volume.procedural == b.volume.procedural);
-  CHECK(a.volume.dims == b.volume.dims);
-  REQUIRE(a.volume.spacing.has_value() == b.volume.spacing.has_value());
-  if (a.volume.spacing) requireSameVec(*a.volume.spacing, *b.volume.spacing);
-  REQUIRE(a.transfer.points.size() == b.transfer.points.size());
-  for (std::size_t i = 0; i < a.transfer.points.size(); ++i) {
-    const TransferPoint &p = a.transfer.points[i], &q = b.transfer.points[i];
+  CHECK(a.volumes.front().source.file == b.volumes.front().source.file);
+  CHECK(a.volumes.front().source.procedural == b.volumes.front().source.procedural);
+  CHECK(a.volumes.front().source.dims == b.volumes.front().source.dims);
+  REQUIRE(a.volumes.front().source.spacing.has_value() == b.volumes.front().source.spacing.has_value());
+  if (a.volumes.front().source.spacing) requireSameVec(*a.volumes.front().source.spacing, *b.volumes.front().source.spacing);
+  REQUIRE(a.volumes.front().transfer.points.size() == b.volumes.front().transfer.points.size());
+  for (std::size_t i = 0; i < a.volumes.front().transfer.points.size(); ++i) {
+    const TransferPoint &p = a.volumes.front().transfer.points[i], &q = b.volumes.front().transfer.points[i];
     CHECK(p.scalar == q.scalar);
     CHECK(p.r == q.r);
     CHECK(p.g == q.g);
     CHECK(p.b == q.b);
     CHECK(p.opacity == q.opacity);
   }
-  CHECK(a.transfer.unitDistance == b.transfer.unitDistance);
+  CHECK(a.volumes.front().transfer.unitDistance == b.volumes.front().transfer.unitDistance);
   CHECK(a.camera.projection == b.camera.projection);
   requireSameVec(a.camera.eye, b.camera.eye);
   requireSameVec(a.camera.lookAt, b.camera.lookAt);
@@ -109,16 +109,16 @@ void requireSameScene(const Scene& a, const Scene& b) {
 
 TEST_CASE("the full example of docs/scene.md parses to its values", "[scene]") {
   const Scene s = parseScene(docsFullExample(), "");
-  CHECK(s.volume.procedural == "shepp-logan");
-  CHECK(s.volume.file.empty());
-  CHECK(s.volume.dims == IVec3{128, 128, 128});
-  REQUIRE(s.volume.spacing);
-  CHECK(s.volume.spacing->y == 0.015748);
-  REQUIRE(s.transfer.points.size() == 9);
-  CHECK(s.transfer.points[4].scalar == 0.3);
-  CHECK(s.transfer.points[4].g == 0.8);
-  CHECK(s.transfer.points[4].opacity == 0.15);
-  CHECK(s.transfer.unitDistance == 0.015748);
+  CHECK(s.volumes.front().source.procedural == "shepp-logan");
+  CHECK(s.volumes.front().source.file.empty());
+  CHECK(s.volumes.front().source.dims == IVec3{128, 128, 128});
+  REQUIRE(s.volumes.front().source.spacing);
+  CHECK(s.volumes.front().source.spacing->y == 0.015748);
+  REQUIRE(s.volumes.front().transfer.points.size() == 9);
+  CHECK(s.volumes.front().transfer.points[4].scalar == 0.3);
+  CHECK(s.volumes.front().transfer.points[4].g == 0.8);
+  CHECK(s.volumes.front().transfer.points[4].opacity == 0.15);
+  CHECK(s.volumes.front().transfer.unitDistance == 0.015748);
   CHECK_FALSE(s.camera.automatic);
   CHECK(s.camera.projection == Projection::kPerspective);
   CHECK(s.camera.eye == Vec3{3.3, -5.72, 2.4});
@@ -134,8 +134,8 @@ TEST_CASE("the full example of docs/scene.md parses to its values", "[scene]") {
 TEST_CASE("a scene with only a volume takes the defaults of scene.h", "[scene]") {
   const Scene s = parseScene(json::parse(R"({"volume": {"procedural": "shepp-logan"}})"), "");
   const Scene d;
-  CHECK(s.volume.dims == d.volume.dims);
-  CHECK_FALSE(s.volume.spacing);
+  CHECK(s.volumes.front().source.dims == d.volumes.front().source.dims);
+  CHECK_FALSE(s.volumes.front().source.spacing);
   CHECK(s.camera.automatic);
   CHECK(s.camera.projection == Projection::kPerspective);
   CHECK(s.image.width == d.image.width);
@@ -147,13 +147,13 @@ TEST_CASE("a scene with only a volume takes the defaults of scene.h", "[scene]")
   CHECK_FALSE(s.shading.enabled);
   CHECK(s.shading.ambient == d.shading.ambient);
   CHECK(s.shading.lightDirection == d.shading.lightDirection);
-  CHECK(s.transfer.unitDistance == 0);
+  CHECK(s.volumes.front().transfer.unitDistance == 0);
   // No transfer function: the documented white ramp over [0, 1].
-  REQUIRE(s.transfer.points.size() == 2);
-  CHECK(s.transfer.points[0].scalar == 0);
-  CHECK(s.transfer.points[0].opacity == 0);
-  CHECK(s.transfer.points[1].scalar == 1);
-  CHECK(s.transfer.points[1].opacity == 1);
+  REQUIRE(s.volumes.front().transfer.points.size() == 2);
+  CHECK(s.volumes.front().transfer.points[0].scalar == 0);
+  CHECK(s.volumes.front().transfer.points[0].opacity == 0);
+  CHECK(s.volumes.front().transfer.points[1].scalar == 1);
+  CHECK(s.volumes.front().transfer.points[1].opacity == 1);
 }
 
 TEST_CASE("a camera section turns the automatic camera off, perspective fov defaults to 30", "[scene]") {
@@ -174,21 +174,21 @@ TEST_CASE("a camera section turns the automatic camera off, perspective fov defa
 TEST_CASE("relative paths resolve against the base directory", "[scene]") {
   json doc = baseDoc();
   doc["volume"] = {{"file", "data/ct.nhdr"}};
-  CHECK(parseScene(doc, "/scenes/a").volume.file == "/scenes/a/data/ct.nhdr");
+  CHECK(parseScene(doc, "/scenes/a").volumes.front().source.file == "/scenes/a/data/ct.nhdr");
   doc["volume"] = {{"file", "../ct.nhdr"}};
-  CHECK(parseScene(doc, "/scenes/a").volume.file == "/scenes/ct.nhdr");
+  CHECK(parseScene(doc, "/scenes/a").volumes.front().source.file == "/scenes/ct.nhdr");
   doc["volume"] = {{"file", "/abs/ct.nhdr"}};
-  CHECK(parseScene(doc, "/scenes/a").volume.file == "/abs/ct.nhdr");
+  CHECK(parseScene(doc, "/scenes/a").volumes.front().source.file == "/abs/ct.nhdr");
   doc["volume"] = {{"file", "ct.nhdr"}};
-  CHECK(parseScene(doc, "").volume.file == "ct.nhdr");
+  CHECK(parseScene(doc, "").volumes.front().source.file == "ct.nhdr");
 }
 
 TEST_CASE("unknown keys are errors naming the key path and the known keys", "[scene]") {
   struct Case { const char* pointer; const char* message; };
   const Case cases[] = {
-      {"/fov", "fov: unknown key (known: volume, timestep, transfer_function, camera, image, sampling, shading)"},
+      {"/fov", "fov: unknown key (known: volume, volumes, timestep, transfer_function, parameters, camera, image, sampling, shading)"},
       {"/camera/fov", "camera.fov: unknown key (known: projection, eye, look_at, up, height, fov_y_deg)"},
-      {"/volume/dim", "volume.dim: unknown key (known: file, procedural, dims, spacing)"},
+      {"/volume/dim", "volume.dim: unknown key (known: file, procedural, computation, dims, spacing)"},
       {"/transfer_function/point", "transfer_function.point: unknown key (known: points, paraview_preset, paraview, unit_distance)"},
       {"/image/size", "image.size: unknown key (known: width, height, background)"},
       {"/sampling/steps", "sampling.steps: unknown key (known: step, preintegrated, early_termination)"},
@@ -261,15 +261,16 @@ TEST_CASE("wrong types and bad values are errors naming the key path", "[scene]"
 TEST_CASE("structural errors name the section", "[scene]") {
   json doc = baseDoc();
   doc.erase("volume");
-  CHECK(parseError(doc) == "volume: missing (every scene names its volume)");
+  CHECK(parseError(doc) == "volume: missing (every scene names its volume, or its \"volumes\")");
 
   doc = baseDoc();
   doc["volume"]["file"] = "ct.nhdr";
-  CHECK(parseError(doc) == "volume: needs exactly one of 'file' (a volume file) or 'procedural' (a generated volume)");
+  CHECK(parseError(doc) == "volume: needs exactly one of 'file' (a volume file), 'procedural' (a generated volume) or "
+                          "'computation' (a user computation on the ranks)");
   doc["volume"] = json::object();
   CHECK(parseError(doc).rfind("volume: needs exactly one of", 0) == 0);
   doc["volume"] = {{"file", "ct.nhdr"}, {"dims", {4, 4, 4}}};
-  CHECK(parseError(doc) == "volume.dims: only for a procedural volume (a file carries its own)");
+  CHECK(parseError(doc) == "volume.dims: only for a procedural or computation volume (a file carries its own)");
 
   doc = baseDoc();
   doc["transfer_function"]["paraview_preset"] = "bone.json";
@@ -332,9 +333,9 @@ TEST_CASE("parseScene(sceneToJson(s)) gives back s", "[scene]") {
   }
   SECTION("every key set away from its default, through text") {
     Scene s;
-    s.volume.file = "/data/ct.nhdr";
-    s.transfer.points = {{-1000, 0, 0, 0, 0}, {0.1, 0.25, 1.0 / 3.0, 2.5, 0.125}, {0.1, 1, 1, 1, 1}};
-    s.transfer.unitDistance = 0.957031;
+    s.volumes.front().source.file = "/data/ct.nhdr";
+    s.volumes.front().transfer.points = {{-1000, 0, 0, 0, 0}, {0.1, 0.25, 1.0 / 3.0, 2.5, 0.125}, {0.1, 1, 1, 1, 1}};
+    s.volumes.front().transfer.unitDistance = 0.957031;
     s.camera = {Projection::kOrthographic, {1e-3, -7, 2}, {0.5, 0.25, -1}, {0, 1, 1}, 3.75, 45, false};
     s.image = {640, 480, {0.1, 0.2, 0.3, 0.4}};
     s.sampling = {0.1 + 0.2, true, 0.95};
@@ -350,10 +351,10 @@ TEST_CASE("parseScene(sceneToJson(s)) gives back s", "[scene]") {
   }
   SECTION("a procedural volume with spacing and a perspective camera") {
     Scene s;
-    s.volume.procedural = "shepp-logan";
-    s.volume.dims = {5, 7, 1};
-    s.volume.spacing = Vec3{0.5, 0.25, 2};
-    s.transfer.points = {{0.5, 1, 0, 0, 0.5}};
+    s.volumes.front().source.procedural = "shepp-logan";
+    s.volumes.front().source.dims = {5, 7, 1};
+    s.volumes.front().source.spacing = Vec3{0.5, 0.25, 2};
+    s.volumes.front().transfer.points = {{0.5, 1, 0, 0, 0.5}};
     s.camera = {Projection::kPerspective, {0, 0, 9}, {0, 0, 0}, {0, 1, 0}, 0, 12.5, false};
     requireSameScene(parseScene(sceneToJson(s), ""), s);
     CHECK_FALSE(sceneToJson(s)["camera"].contains("height"));
@@ -374,8 +375,8 @@ TEST_CASE("every example scene parses", "[scene]") {
     if (entry.path().extension() != ".json") continue;
     INFO(entry.path().string());
     const Scene s = loadSceneFile(entry.path().string());
-    CHECK_FALSE(s.transfer.points.empty());
-    CHECK((s.volume.file.empty() || fs::path(s.volume.file).is_absolute()));
+    CHECK_FALSE(s.volumes.front().transfer.points.empty());
+    CHECK((s.volumes.front().source.file.empty() || fs::path(s.volumes.front().source.file).is_absolute()));
     ++count;
   }
   CHECK(count >= 6);
@@ -384,7 +385,7 @@ TEST_CASE("every example scene parses", "[scene]") {
   const Scene ct = loadSceneFile((kSourceRoot / "examples" / "scenes" / "ct_head_bone.json").string());
   const fs::path shared = fs::path(PVR_SHARED_DATA) / "ct_head_cranium" / "ct_head_cranium.json";
   if (fs::exists(shared)) {
-    CHECK(fs::equivalent(ct.volume.file, shared));
+    CHECK(fs::equivalent(ct.volumes.front().source.file, shared));
   } else {
     WARN("shared data missing (" << shared.string() << "): path resolution not checked against it");
   }
@@ -403,7 +404,7 @@ TEST_CASE("resolveDefaults fills unit distance, step and the automatic camera", 
   SECTION("from a scene with only a volume") {
     Scene s = parseScene(json::parse(R"({"volume": {"procedural": "shepp-logan"}})"), "");
     resolveDefaults(s, grid);
-    CHECK(s.transfer.unitDistance == 0.5);
+    CHECK(s.volumes.front().transfer.unitDistance == 0.5);
     CHECK(s.sampling.step == 0.25);
     CHECK_FALSE(s.camera.automatic);
     CHECK(s.camera.projection == Projection::kPerspective);
@@ -443,7 +444,7 @@ TEST_CASE("resolveDefaults fills unit distance, step and the automatic camera", 
     Scene s = parseScene(baseDoc(), "");
     const CameraSpec before = s.camera;
     resolveDefaults(s, grid);
-    CHECK(s.transfer.unitDistance == 0.1);
+    CHECK(s.volumes.front().transfer.unitDistance == 0.1);
     CHECK(s.sampling.step == 0.05);
     CHECK(s.camera.eye == before.eye);
     CHECK(s.camera.lookAt == before.lookAt);

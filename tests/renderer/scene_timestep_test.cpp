@@ -6,6 +6,7 @@
 
 #include "error.h"
 #include "scene.h"
+#include "scene_errors.h"
 #include "scene_volume.h"
 #include "volume_test_files.h"
 
@@ -20,16 +21,6 @@ json sceneWith(const json& timestep) {
   json doc = {{"volume", {{"procedural", "constant-slab"}, {"dims", {2, 2, 2}}}}};
   if (!timestep.is_null()) doc["timestep"] = timestep;
   return doc;
-}
-
-std::string parseError(const json& doc) {
-  try {
-    parseScene(doc, "");
-  } catch (const pvr::Error& e) {
-    CHECK(e.code() == pvr::ErrorCode::kInvalidArgument);
-    return e.what();
-  }
-  return "(no error)";
 }
 
 // A series sidecar of `steps` raw+JSON volumes in `dir`.
@@ -48,17 +39,17 @@ std::string writeSeries(const std::string& dir, int steps) {
 }  // namespace
 
 TEST_CASE("timestep is a 0-based integer, 0 by default, and prints back", "[scene][series]") {
-  CHECK(parseScene(sceneWith(nullptr), "").volume.timestep == 0);
+  CHECK(parseScene(sceneWith(nullptr), "").volumes.front().source.timestep == 0);
   const Scene s = parseScene(sceneWith(7), "");
-  CHECK(s.volume.timestep == 7);
+  CHECK(s.volumes.front().source.timestep == 7);
   CHECK(sceneToJson(s)["timestep"] == 7);
-  CHECK(parseScene(sceneToJson(s), "").volume.timestep == 7);
+  CHECK(parseScene(sceneToJson(s), "").volumes.front().source.timestep == 7);
 
-  CHECK(parseError(sceneWith(-1)) == "timestep: must be in 0..2147483647 (a 0-based step), got -1");
-  CHECK(parseError(sceneWith(std::int64_t(1) << 31)) ==
+  CHECK(sceneParseError(sceneWith(-1)) == "timestep: must be in 0..2147483647 (a 0-based step), got -1");
+  CHECK(sceneParseError(sceneWith(std::int64_t(1) << 31)) ==
         "timestep: must be in 0..2147483647 (a 0-based step), got 2147483648");
-  CHECK(parseError(sceneWith(1.5)) == "timestep: must be an integer, got number 1.5");
-  CHECK(parseError(sceneWith("2")) == "timestep: must be an integer, got string \"2\"");
+  CHECK(sceneParseError(sceneWith(1.5)) == "timestep: must be an integer, got number 1.5");
+  CHECK(sceneParseError(sceneWith("2")) == "timestep: must be an integer, got string \"2\"");
 }
 
 TEST_CASE("openSceneVolume checks the timestep against the volume's steps, naming the dataset", "[scene][series]") {
