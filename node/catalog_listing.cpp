@@ -7,7 +7,9 @@
 #include <set>
 
 #include "error.h"
+#include "io/data_directory.h"
 #include "io/series.h"
+#include "scene_patch.h"
 
 namespace pvr::node {
 
@@ -20,34 +22,28 @@ std::string realPath(const std::string& path) {
   return ::realpath(path.c_str(), buf) ? std::string(buf) : std::string();
 }
 
-bool inside(const std::string& root, const std::string& path) {
-  return !path.empty() && path.size() > root.size() && path.compare(0, root.size(), root) == 0 &&
-         (root == "/" || path[root.size()] == '/');
-}
-
 // A file the catalog considers: its name relative to the directory and its real path.
 struct Candidate {
   std::string name;
   std::string real;
 };
 
-// Dataset-named regular files in `root` and one level below, inside `root`.
-std::vector<Candidate> candidates(const std::string& root) {
+// Dataset-named regular files in the directory and one level below, inside
+// it; not the server's presets (kPresetFolder).
+std::vector<Candidate> candidates(const core::DataDirectory& dir) {
   std::vector<Candidate> out;
   std::error_code ec;
   const auto consider = [&](const fs::path& file, const std::string& name) {
     if (!core::isDatasetFileName(name)) return;
-    const std::string real = realPath(file.string());
-    if (inside(root, real) && fs::is_regular_file(real, ec)) out.push_back({name, real});
+    if (auto real = dir.confine(file.string())) out.push_back({name, *real});
   };
-  for (const auto& entry : fs::directory_iterator(root, ec)) {
+  for (const auto& entry : fs::directory_iterator(dir.path(), ec)) {
     const std::string top = entry.path().filename().string();
-    if (top.empty() || top[0] == '.') continue;
+    if (top.empty() || top[0] == '.' || top == kPresetFolder) continue;
     if (!entry.is_directory(ec)) {
       consider(entry.path(), top);
       continue;
     }
-    if (!inside(root, realPath(entry.path().string()))) continue;
     for (const auto& sub : fs::directory_iterator(entry.path(), ec)) {
       const std::string leaf = sub.path().filename().string();
       if (!leaf.empty() && leaf[0] != '.') consider(sub.path(), top + "/" + leaf);
@@ -59,22 +55,23 @@ std::vector<Candidate> candidates(const std::string& root) {
 }  // namespace
 
 CatalogListing listCatalog(const std::string& dataDir) {
-  const std::string root = realPath(dataDir);
   std::error_code ec;
-  if (root.empty() || !fs::is_directory(root, ec)) throw Error(ErrorCode::kIo, dataDir + ": no such directory");
+  if (!fs::is_directory(dataDir, ec)) throw Error(ErrorCode::kIo, dataDir + ": no such directory");
+  const core::DataDirectory within(dataDir);
 
-  // Open every candidate (headers only); remember what the series read.
+  // Open every candidate (headers only), refusing files they name outside
+  // the directory; remember what the series read.
   CatalogListing listing;
   std::vector<CatalogDataset> opened;
   std::vector<std::string> openedReal;
   std::set<std::string> stepFiles;
-  for (const Candidate& c : candidates(root)) {
+  for (const Candidate& c : candidates(within)) {
     if (c.name.find_first_of("\t\n") != std::string::npos) {
       listing.leftOut.push_back(c.name + ": the name holds a tab or line break, which a catalog line cannot");
       continue;
     }
     try {
-      const auto source = core::openVolumeFile(c.real);
+      const auto source = core::openVolumeFile(c.real, &within);
       for (const std::string& file : core::seriesFiles(*source)) stepFiles.insert(realPath(file));
       opened.push_back({c.name, source->steps()});
       openedReal.push_back(c.real);

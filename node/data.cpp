@@ -8,6 +8,7 @@
 
 #include "cache_cluster.h"
 #include "decompose/content.h"
+#include "io/data_directory.h"
 #include "scene_volume.h"
 #include "transfer.h"
 
@@ -110,7 +111,9 @@ Reload openScene(NodeState& state, const std::string& sceneJson) {
   std::unique_ptr<core::VolumeSource> source;
   const core::VolumeSource* grid = state.source.get();
   if (changed) {
-    source = core::openSceneVolume(scene.volumes.front().source);
+    // Only what lies inside the data directory: the client named it.
+    const core::DataDirectory within(state.dataDir);
+    source = core::openSceneVolume(scene.volumes.front().source, &within);
     grid = source.get();
   }
   core::checkTimestep(scene.volumes.front().source, *grid);

@@ -4,6 +4,9 @@
 #include <cstdlib>
 #include <cstring>
 
+#include <unistd.h>
+
+#include "io/data_directory.h"
 #include "io/volume_io.h"
 #include "scene.h"
 #include "wire_error.h"
@@ -15,13 +18,40 @@ namespace {
 using proto::ErrorCode;
 using proto::ProtocolError;
 
-// The real path of `dataset` if it lies inside `dataDir`.
+// The real path of `dataset` if it is a regular file inside `dataDir`.
 std::optional<std::string> resolveDataset(const std::string& dataset, const std::string& dataDir) {
-  char real[PATH_MAX];
-  const std::string wanted = dataset[0] == '/' ? dataset : dataDir + "/" + dataset;
-  if (dataDir.empty() || !::realpath(wanted.c_str(), real)) return std::nullopt;
-  if (std::strncmp(real, dataDir.c_str(), dataDir.size()) != 0 || real[dataDir.size()] != '/') return std::nullopt;
-  return std::string(real);
+  if (dataDir.empty()) return std::nullopt;
+  return core::DataDirectory(dataDir).confine(dataset);
+}
+
+// Server-side ParaView presets: a client names one by its file name in the
+// data directory's presets/ folder (its own presets it sends as content,
+// "paraview"). Rewrites each "paraview_preset" of the document to the real
+// path, or returns the error that refuses it: the same words whether the
+// file is missing, outside the folder or not a regular file.
+std::optional<ProtocolError> resolvePresets(nlohmann::json& doc, const std::string& dataDir) {
+  const auto resolve = [&](nlohmann::json& tf, const std::string& where) -> std::optional<ProtocolError> {
+    if (!tf.is_object() || !tf.contains("paraview_preset") || !tf["paraview_preset"].is_string()) return std::nullopt;
+    const std::string named = tf["paraview_preset"].get<std::string>();
+    std::optional<std::string> real;
+    const std::string folder = dataDir + "/" + kPresetFolder;
+    if (!dataDir.empty() && ::access(folder.c_str(), X_OK) == 0) real = core::DataDirectory(folder).confine(named);
+    if (!real)
+      return ProtocolError{ErrorCode::kBadArgument, where + ".paraview_preset: no preset '" + named +
+                                                        "' in the data directory's " + kPresetFolder +
+                                                        "/ folder (send your own preset as \"paraview\")"};
+    tf["paraview_preset"] = *real;
+    return std::nullopt;
+  };
+  if (doc.contains("transfer_function"))
+    if (auto e = resolve(doc["transfer_function"], "scene.transfer_function")) return e;
+  if (doc.contains("volumes") && doc["volumes"].is_array())
+    for (std::size_t i = 0; i < doc["volumes"].size(); ++i)
+      if (doc["volumes"][i].is_object() && doc["volumes"][i].contains("transfer_function"))
+        if (auto e = resolve(doc["volumes"][i]["transfer_function"],
+                             "scene.volumes[" + std::to_string(i) + "].transfer_function"))
+          return e;
+  return std::nullopt;
 }
 
 // What the scene parser checks a document against before a volume is named:
@@ -53,6 +83,7 @@ std::variant<SessionScene, ProtocolError> patchScene(const SessionScene& current
     }
     next.doc.merge_patch(patch);
   }
+  if (auto refused = resolvePresets(next.doc, dataDir)) return *refused;
   if (!request.dataset.empty()) {
     const auto file = resolveDataset(request.dataset, dataDir);
     if (!file)

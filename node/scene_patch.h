@@ -17,6 +17,10 @@
 
 namespace pvr::node {
 
+// The folder of the data directory that holds the server's ParaView
+// presets: a scene's "paraview_preset" names a file in it (docs/runtime.md).
+inline constexpr const char* kPresetFolder = "presets";
+
 struct SessionScene {
   nlohmann::json doc = nlohmann::json::object();      // without "runtime"
   nlohmann::json runtime = nlohmann::json::object();  // the merged "runtime" object
@@ -28,7 +32,10 @@ struct SessionScene {
 // `current` with `request` applied and checked, or the error that refuses
 // it. The dataset name resolves inside `dataDir` (a real path), to the
 // volume file the ranks open; a "volume" with a "file" in the JSON is
-// refused, so files come only through dataset names.
+// refused, so files come only through dataset names; a "paraview_preset"
+// resolves inside dataDir/presets. Every name resolves to a regular file
+// inside its folder after symlinks, or is refused in the same words
+// whether it exists or not.
 std::variant<SessionScene, proto::ProtocolError> patchScene(const SessionScene& current,
                                                             const proto::SetScene& request,
                                                             const std::string& dataDir);

@@ -1,9 +1,11 @@
 #include "brick.h"
 
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <new>
 
@@ -17,6 +19,35 @@ constexpr std::size_t kHugePage = std::size_t(2) << 20;
 // Below this a brick's page faults do not matter.
 constexpr std::size_t kHugeStorage = std::size_t(64) << 20;
 }  // namespace
+
+namespace {
+
+// Physical memory of this host: no brick larger than that can be held, and
+// asking for one would fail late (std::bad_alloc) or push the host into swap.
+std::uint64_t physicalMemory() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGESIZE);
+  return pages > 0 && size > 0 ? std::uint64_t(pages) * std::uint64_t(size) : UINT64_MAX;
+}
+
+std::string gibText(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f GiB", bytes / double(1ull << 30));
+  return text;
+}
+
+}  // namespace
+
+std::size_t Brick::checkedStorageBytes(const NodeBox& stored, ScalarType type) {
+  // Node counts are at most 2^31 per axis: the product of three fits a long double exactly enough.
+  const long double bytes = (long double)stored.extent(0) * (long double)stored.extent(1) *
+                            (long double)stored.extent(2) * (long double)scalarSize(type);
+  const std::uint64_t memory = physicalMemory();
+  if (bytes > (long double)memory)
+    throw Error(ErrorCode::kUnsupported, "brick " + toString(stored) + " of " + std::string(scalarName(type)) +
+                                             " needs " + gibText(double(bytes)) + "; this host has " +
+                                             gibText(double(memory)) + " of memory (use more ranks or hosts)");
+  return std::size_t(bytes);
+}
 
 void* Brick::allocateStorage(std::size_t bytes) {
   if (bytes < kHugeStorage) return ::operator new(bytes);
@@ -39,7 +70,7 @@ Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, co
     throw Error(ErrorCode::kInvalidArgument,
                 "brick: owned box " + toString(owned) + " must lie in stored box " +
                     toString(stored) + " inside the grid " + toString(grid.allNodes()));
-  data_.resize(std::size_t(stored.nodeCount()) * scalarSize(type) + kPaddingBytes);
+  data_.resize(checkedStorageBytes(stored, type) + kPaddingBytes);
   std::fill(data_.end() - kPaddingBytes, data_.end(), std::byte{0});
 }
 

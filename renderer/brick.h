@@ -100,6 +100,9 @@ class Brick {
   // kernel offers them: a gigabyte brick then costs 512 page faults while
   // it is read instead of 262144 (brick.cpp).
   static void* allocateStorage(std::size_t bytes);
+  // The bytes of a stored box's voxels; throws pvr::Error(kUnsupported)
+  // when they exceed this host's physical memory, before anything is allocated.
+  static std::size_t checkedStorageBytes(const NodeBox& stored, ScalarType type);
   static void freeStorage(void* p, std::size_t bytes) noexcept;
   // std::allocator, except that resize() leaves new bytes unwritten and
   // the storage comes from allocateStorage.

@@ -74,6 +74,13 @@ struct ImageSpec {
   std::array<double, 4> background{0, 0, 0, 1};  // straight (not premultiplied) RGBA
 };
 
+// The most samples a ray may take across the scene's domain: a step so
+// small that the domain's diagonal needs more is refused when the scene is
+// resolved (a step of 1e-9 would otherwise render for hours, and one of
+// 1e-20 would not advance at all). 2^20 samples is a quarter-voxel step
+// across the diagonal of a 240000-voxel-wide grid.
+inline constexpr double kMaxSamplesPerRay = 1 << 20;
+
 struct SamplingSpec {
   double step = 0;              // world length; 0 = half the smallest spacing
   bool preintegrated = false;

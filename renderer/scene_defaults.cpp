@@ -4,9 +4,13 @@
 #include <cmath>
 #include <numbers>
 
+#include "error.h"
 #include "scene.h"
+#include "scene_json.h"
 
 namespace pvr::core {
+
+using scene_json::numberText;
 
 CameraSpec automaticCamera(const GridGeometry& grid, int width, int height) {
   constexpr double kFovYDeg = 30, kElevationDeg = 20, kAzimuthDeg = 30, kMargin = 1.05;
@@ -42,6 +46,13 @@ void resolveDefaults(Scene& scene, const GridGeometry& grid) {
   for (SceneVolume& v : scene.volumes)
     if (v.transfer.unitDistance == 0) v.transfer.unitDistance = voxel;
   if (scene.sampling.step == 0) scene.sampling.step = 0.5 * voxel;
+  const double diagonal = length(grid.domainMax() - grid.domainMin());
+  if (diagonal / scene.sampling.step > kMaxSamplesPerRay)
+    throw Error(ErrorCode::kInvalidArgument,
+                "sampling.step: " + numberText(scene.sampling.step) + " gives " + numberText(diagonal / scene.sampling.step) +
+                    " samples across the domain's diagonal (" + numberText(diagonal) + "); at most " +
+                    numberText(kMaxSamplesPerRay) + " are allowed, so the step must be at least " +
+                    numberText(diagonal / kMaxSamplesPerRay));
   if (scene.camera.automatic) scene.camera = automaticCamera(grid, scene.image.width, scene.image.height);
 }
 

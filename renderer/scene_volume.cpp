@@ -4,13 +4,13 @@
 
 namespace pvr::core {
 
-std::unique_ptr<VolumeSource> openSceneVolume(const VolumeSpec& spec) {
+std::unique_ptr<VolumeSource> openSceneVolume(const VolumeSpec& spec, const DataDirectory* within) {
   if (!spec.computation.empty())
     throw Error(ErrorCode::kInvalidArgument, "volume.computation '" + spec.computation +
                                                  "': a computation runs on the ranks of a pvr-node session "
                                                  "(docs/steering.md), not from a file or a generator");
   std::unique_ptr<VolumeSource> source;
-  if (!spec.file.empty()) source = openVolumeFile(spec.file);
+  if (!spec.file.empty()) source = openVolumeFile(spec.file, within);
   else if (spec.spacing) source = openProcedural(spec.procedural, spec.dims, *spec.spacing);
   else source = openProcedural(spec.procedural, spec.dims);
   checkTimestep(spec, *source);

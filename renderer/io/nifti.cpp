@@ -135,7 +135,8 @@ bool isNiftiPath(const std::string& path) {
   return pathEndsWith(path, ".nii") || pathEndsWith(path, ".nii.gz");
 }
 
-std::unique_ptr<VolumeSource> openNifti(const std::string& path) {
+// One file, no names inside: openVolumeFile confined it already.
+std::unique_ptr<VolumeSource> openNifti(const std::string& path, const DataDirectory*) {
   const bool gzip = pathEndsWith(path, ".gz");
   checkNifti1Header(path, gzip);
 

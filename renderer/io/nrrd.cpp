@@ -56,7 +56,7 @@ bool isNrrdPath(const std::string& path) {
   return pathEndsWith(path, ".nrrd") || pathEndsWith(path, ".nhdr");
 }
 
-std::unique_ptr<VolumeSource> openNrrd(const std::string& path) {
+std::unique_ptr<VolumeSource> openNrrd(const std::string& path, const DataDirectory* within) {
   bool complete = false;
   const std::string text = readHeaderText(path, complete);
   const NrrdHeader h = parseNrrdHeader(text, complete, path);
@@ -67,8 +67,10 @@ std::unique_ptr<VolumeSource> openNrrd(const std::string& path) {
   std::uint64_t start = 0;
   if (!h.dataFile.empty()) {
     const std::filesystem::path named(h.dataFile);
-    layout.dataPath = named.is_absolute() ? named.string()
-                                          : (std::filesystem::path(path).parent_path() / named).string();
+    layout.dataPath = confineTo(within,
+                                named.is_absolute() ? named.string()
+                                                    : (std::filesystem::path(path).parent_path() / named).string(),
+                                path);
   } else if (h.dataStart) {
     layout.dataPath = path;
     start = *h.dataStart;

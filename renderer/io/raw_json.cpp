@@ -96,7 +96,8 @@ std::string rawPathFor(const json& doc, const std::string& jsonPath, const std::
 // pattern names for it; the sidecar's grid, type and byte order apply to
 // every step.
 std::unique_ptr<VolumeSource> openRawSeries(const json& doc, const std::string& jsonPath, const std::string& givenRaw,
-                                            const GridGeometry& grid, ScalarType type, const RawLayout& layout) {
+                                            const GridGeometry& grid, ScalarType type, const RawLayout& layout,
+                                            const DataDirectory* within) {
   if (!givenRaw.empty())
     failAt(ErrorCode::kBadFile, givenRaw,
            "sidecar " + jsonPath + " describes a time series ('pattern'); open the sidecar, not a step's raw file");
@@ -105,7 +106,7 @@ std::unique_ptr<VolumeSource> openRawSeries(const json& doc, const std::string& 
   for (const PatternStep& named : patternSteps(doc, jsonPath)) {
     const std::int64_t k = std::int64_t(steps.size());
     RawLayout step = layout;
-    step.dataPath = stepFilePath(jsonPath, named.file, jsonPath, k);
+    step.dataPath = confineTo(within, stepFilePath(jsonPath, named.file, jsonPath, k), jsonPath);
     step.headerPath.clear();  // the step's label names the sidecar already
     auto volume = openStep(jsonPath, k, named.file, step.dataPath, [&] {
       return openRawVolume(fileNameOf(step.dataPath), grid, type, step, SizeRule::kExact);
@@ -123,12 +124,13 @@ bool isRawJsonPath(const std::string& path) {
 
 bool isRawJsonDataPath(const std::string& path) { return pathEndsWith(path, ".raw"); }
 
-std::unique_ptr<VolumeSource> openRawJson(const std::string& path) {
+std::unique_ptr<VolumeSource> openRawJson(const std::string& path, const DataDirectory* within) {
   // Step: find the sidecar (the path itself, or <stem>.json beside a .raw).
   const bool givenRaw = isRawJsonDataPath(path);
-  const std::string jsonPath = givenRaw ? fs::path(path).replace_extension(".json").string() : path;
+  std::string jsonPath = givenRaw ? fs::path(path).replace_extension(".json").string() : path;
   if (givenRaw && !fs::exists(jsonPath))
     failAt(ErrorCode::kIo, path, "no JSON sidecar " + jsonPath + " beside it (dims, dtype, spacing)");
+  if (givenRaw) jsonPath = confineTo(within, jsonPath, path);
   const json doc = readSidecar(jsonPath);
 
   // Step: the grid, type and byte order it states.
@@ -141,8 +143,9 @@ std::unique_ptr<VolumeSource> openRawJson(const std::string& path) {
   RawLayout layout;
   layout.headerPath = jsonPath;
   layout.bigEndian = readBigEndian(doc, jsonPath);
-  if (doc.contains("pattern")) return openRawSeries(doc, jsonPath, givenRaw ? path : std::string(), grid, type, layout);
-  layout.dataPath = rawPathFor(doc, jsonPath, givenRaw ? path : std::string());
+  if (doc.contains("pattern"))
+    return openRawSeries(doc, jsonPath, givenRaw ? path : std::string(), grid, type, layout, within);
+  layout.dataPath = confineTo(within, rawPathFor(doc, jsonPath, givenRaw ? path : std::string()), jsonPath);
   return openRawVolume(fileNameOf(path), grid, type, std::move(layout), SizeRule::kExact);
 }
 

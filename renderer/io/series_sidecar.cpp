@@ -53,7 +53,7 @@ std::vector<PatternStep> listedSteps(const json& list, const std::string& path) 
 
 bool isSeriesPath(const std::string& path) { return pathEndsWith(path, ".series.json"); }
 
-std::unique_ptr<VolumeSource> openSeries(const std::string& path) {
+std::unique_ptr<VolumeSource> openSeries(const std::string& path, const DataDirectory* within) {
   const json doc = readJsonFile(path);
   if (!doc.is_object()) failAt(ErrorCode::kBadFile, path, "a series sidecar is a JSON object");
   requireKnownKeys(doc, path);
@@ -72,7 +72,7 @@ std::unique_ptr<VolumeSource> openSeries(const std::string& path) {
     auto volume = openStep(path, std::int64_t(k), named[k].file, file, [&] {
       // Refused by name: a sidecar naming itself would never return.
       if (isSeriesPath(file)) failAt(ErrorCode::kBadFile, file, "is itself a series sidecar; a step is one volume");
-      return openVolumeFile(file);
+      return openVolumeFile(file, within);
     });
     steps.push_back({named[k].time, std::move(volume), named[k].file, file});
   }

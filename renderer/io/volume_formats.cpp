@@ -25,12 +25,13 @@ bool isDatasetFileName(const std::string& name) {
   return false;
 }
 
-std::unique_ptr<VolumeSource> openVolumeFile(const std::string& path) {
+std::unique_ptr<VolumeSource> openVolumeFile(const std::string& path, const DataDirectory* within) {
+  if (within) within->require(path, "dataset");
   // A missing file is the likeliest mistake: say so before talking formats.
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) failAt(ErrorCode::kIo, path, "no such file");
   for (const VolumeFormat& format : volumeFormats())
-    if (format.matches(path)) return format.open(path);
+    if (format.matches(path)) return format.open(path, within);
 
   std::string supported;
   for (const VolumeFormat& format : volumeFormats())

@@ -15,6 +15,8 @@
 
 namespace pvr::core {
 
+class DataDirectory;  // data_directory.h
+
 class VolumeSource {
  public:
   virtual ~VolumeSource() = default;
@@ -43,7 +45,7 @@ class VolumeSource {
 struct VolumeFormat {
   const char* name;
   bool (*matches)(const std::string& path);
-  std::unique_ptr<VolumeSource> (*open)(const std::string& path);
+  std::unique_ptr<VolumeSource> (*open)(const std::string& path, const DataDirectory* within);
   const char* extensions = "";  // for messages: ".nrrd .nhdr"
 };
 
@@ -52,8 +54,10 @@ const std::vector<VolumeFormat>& volumeFormats();
 
 // Opens a volume file by its extension. Throws pvr::Error naming the file and
 // what is wrong (missing, unreadable header, unknown type, truncated data,
-// dims that do not match the byte count).
-std::unique_ptr<VolumeSource> openVolumeFile(const std::string& path);
+// dims that do not match the byte count). With `within` (a server opening
+// what a client named), the file and every file its header or sidecar names
+// must be regular files inside that directory (data_directory.h).
+std::unique_ptr<VolumeSource> openVolumeFile(const std::string& path, const DataDirectory* within = nullptr);
 
 // Writes a whole volume (a brick whose stored box is the whole grid) in the
 // raw + JSON sidecar form of ../shared/data that openVolumeFile reads back:

@@ -1,5 +1,6 @@
 // The master's scene patches (scene_patch.h), serially: a patch is checked
 // as a whole, with or without a dataset, and a refused one changes nothing.
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
@@ -23,6 +24,14 @@ struct ScratchDataDir {
     const fs::path d = fs::temp_directory_path() / ("pvr-scene-patch-" + std::to_string(::getpid()));
     fs::create_directories(d);
     std::ofstream(d / "ct.json") << "{}";
+    // A FIFO, a symlink to a device and one leading outside: names a client
+    // may give that must never be opened.
+    ::mkfifo((d / "pipe.json").c_str(), 0600);
+    fs::create_symlink("/dev/zero", d / "zero.raw");
+    fs::create_symlink("/etc/passwd", d / "passwd.json");
+    fs::create_directories(d / "presets");
+    std::ofstream(d / "presets" / "bone.json") << R"([{"Name": "bone", "RGBPoints": [0, 1, 1, 1, 1, 1, 1, 1]}])";
+    std::ofstream(d / "outside.json") << R"([{"Name": "x", "RGBPoints": [0, 1, 1, 1, 1, 1, 1, 1]}])";
     path = fs::canonical(d);
   }
   ~ScratchDataDir() {
@@ -94,6 +103,13 @@ TEST_CASE("datasets resolve inside the data directory, volume files in the JSON 
   CHECK(refused({}, {"", "[1, 2]"}).code == proto::ErrorCode::kBadArgument);
   const SessionScene loaded = accepted({}, {"ct.json", ""});
   CHECK_THAT(refused(loaded, {"", R"({"volume": null})"}).text, Catch::Contains("volume"));
+  // Missing, outside, a FIFO or a device: refused in the same words.
+  for (const char* name : {"missing.json", "pipe.json", "zero.raw", "passwd.json", "/etc/passwd", "presets"}) {
+    INFO(name);
+    const auto e = refused({}, {name, ""});
+    CHECK(e.code == proto::ErrorCode::kDatasetNotFound);
+    CHECK(e.text == std::string("no dataset '") + name + "' in the data directory");
+  }
   // A procedural volume may be named in the JSON.
   CHECK(accepted({}, {"", R"({"volume": {"procedural": "shepp-logan", "dims": [8, 8, 8]}})"}).hasVolume());
 }
@@ -103,4 +119,22 @@ TEST_CASE("runtime null resets the settings to their defaults") {
   CHECK(set.settings.compression == proto::Compression::kRle);
   const SessionScene reset = accepted(set, {"", R"({"runtime": null})"});
   CHECK(reset.settings == node::RuntimeSettings{});
+}
+
+TEST_CASE("a paraview_preset names a file of the data directory's presets folder, nothing else") {
+  const SessionScene bone = accepted({}, {"", R"({"transfer_function": {"paraview_preset": "bone.json"}})"});
+  CHECK(bone.doc["transfer_function"]["paraview_preset"] == (fs::path(dataDir()) / "presets" / "bone.json").string());
+  // Kept resolved, so a later patch checks the same file again and passes.
+  CHECK(accepted(bone, {"", R"({"image": {"width": 32}})"}).doc["transfer_function"] == bone.doc["transfer_function"]);
+  for (const std::string named : {"missing.json", "../outside.json", "/etc/passwd", "../ct.json", "."}) {
+    INFO(named);
+    const auto e = refused({}, {"", R"({"transfer_function": {"paraview_preset": ")" + named + R"("}})"});
+    CHECK(e.code == proto::ErrorCode::kBadArgument);
+    CHECK(e.text == "scene.transfer_function.paraview_preset: no preset '" + named +
+                        "' in the data directory's presets/ folder (send your own preset as \"paraview\")");
+  }
+  // In a volumes list too.
+  const auto e = refused({}, {"", R"({"volumes": [{"name": "a", "procedural": "shepp-logan", )"
+                                  R"("transfer_function": {"paraview_preset": "/etc/shadow"}}]})"});
+  CHECK_THAT(e.text, Catch::StartsWith("scene.volumes[0].transfer_function.paraview_preset: no preset '/etc/shadow'"));
 }
