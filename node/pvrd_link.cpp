@@ -8,14 +8,20 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
+#include <cstdio>
 #include <cstring>
 
 #include "error.h"
 
 namespace pvr::node {
 
-PvrdLink::PvrdLink(const std::string& host, int port) {
+PvrdLink::PvrdLink(const std::string& host, int port, const std::string& jobSecret) {
   const std::string where = host + ":" + std::to_string(port);
+  if (jobSecret.empty())
+    throw Error(ErrorCode::kInvalidArgument, std::string(proto::kJobSecretVariable) +
+                                                 " is not set (pvrd sets it for the job it launches): cannot "
+                                                 "open the secure channel to " + where);
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   addr.sin_port = htons(std::uint16_t(port));
@@ -32,6 +38,22 @@ PvrdLink::PvrdLink(const std::string& host, int port) {
   const int one = 1;
   ::setsockopt(fd_, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
   open_ = true;
+
+  // The handshake, before any frame: pvrd relays nothing until it is done.
+  channel_ = std::make_unique<proto::SecureChannel>(proto::SecureChannel::Role::kClient, jobSecret,
+                                                    proto::kConnectBackPurpose);
+  flush();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(kHandshakeSeconds);
+  while (open_ && !channel_->established()) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0 || !readSome(int(left.count()))) break;
+  }
+  if (!channel_->established()) {
+    const std::string why = channel_->failed() ? "pvrd does not hold this job's secret"
+                                               : "no handshake within " + std::to_string(kHandshakeSeconds) + " s";
+    close();
+    throw Error(ErrorCode::kIo, "secure channel to " + where + ": " + why);
+  }
 }
 
 PvrdLink::~PvrdLink() { close(); }
@@ -42,7 +64,8 @@ void PvrdLink::close() {
   open_ = false;
 }
 
-void PvrdLink::sendRaw(std::span<const std::uint8_t> bytes) {
+void PvrdLink::flush() {
+  const std::vector<std::uint8_t> bytes = channel_->takeOutgoing();
   std::size_t done = 0;
   while (open_ && done < bytes.size()) {
     const ssize_t n = ::send(fd_, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
@@ -53,6 +76,36 @@ void PvrdLink::sendRaw(std::span<const std::uint8_t> bytes) {
     }
     done += std::size_t(n);
   }
+}
+
+bool PvrdLink::readSome(int timeoutMs) {
+  for (;;) {
+    pollfd p{fd_, POLLIN, 0};
+    const int ready = ::poll(&p, 1, timeoutMs);
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready == 0) return true;
+    if (ready < 0) return open_ = false;
+    std::uint8_t buf[64 << 10];
+    const ssize_t n = ::read(fd_, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return open_ = false;
+    const auto failure = channel_->receive(std::span(buf, std::size_t(n)));
+    flush();  // handshake replies, or the alert that says why we stop
+    if (failure) {
+      std::fprintf(stderr, "pvr-node: rank 0: %s\n", failure->text.c_str());
+      return open_ = false;
+    }
+    return true;
+  }
+}
+
+void PvrdLink::sendRaw(std::span<const std::uint8_t> bytes) {
+  if (!open_) return;
+  if (channel_->send(bytes)) {
+    open_ = false;
+    return;
+  }
+  flush();
 }
 
 void PvrdLink::send(const proto::Message& m, std::uint32_t id, bool final) {
@@ -69,18 +122,16 @@ std::optional<proto::Decoded> PvrdLink::next(bool wait) {
       return std::nullopt;
     }
     if (!open_) return std::nullopt;
+    const std::vector<std::uint8_t> plain = channel_->takeIncoming();
+    if (!plain.empty()) {
+      decoder_.feed(plain);
+      continue;
+    }
     pollfd p{fd_, POLLIN, 0};
     const int ready = ::poll(&p, 1, wait ? -1 : 0);
     if (ready < 0 && errno == EINTR) continue;
     if (ready <= 0) return std::nullopt;
-    std::uint8_t buf[64 << 10];
-    const ssize_t n = ::read(fd_, buf, sizeof buf);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      open_ = false;
-      return std::nullopt;
-    }
-    decoder_.feed(std::span(buf, std::size_t(n)));
+    if (!readSome(0)) return std::nullopt;
   }
 }
 

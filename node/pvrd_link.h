@@ -1,22 +1,30 @@
 // The master rank's connection back to its pvrd session handler: the one
-// place of the node that touches a socket. Frames in are decoded
+// place of the node that touches a socket. Every byte travels inside a
+// SecureChannel keyed by the job secret (docs/protocol.md, "The secure
+// channel"), so only the pvrd that launched the job can talk to it and no
+// one in between can read or alter the frames. Frames in are decoded
 // incrementally; frames out are encoded protocol messages.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
 
 #include "pvr_protocol.h"
+#include "secure_channel.h"
 
 namespace pvr::node {
 
 class PvrdLink {
  public:
-  // Connects to HOST:PORT (numeric IPv4); throws pvr::Error (kIo) naming
-  // the address and the reason.
-  PvrdLink(const std::string& host, int port);
+  // Connects to HOST:PORT (numeric IPv4) and completes the secure
+  // channel's handshake with the job secret, waiting at most
+  // kHandshakeSeconds; throws pvr::Error (kIo, or kInvalidArgument for an
+  // empty secret) naming the address and the reason.
+  PvrdLink(const std::string& host, int port, const std::string& jobSecret);
+  static constexpr int kHandshakeSeconds = 30;
   ~PvrdLink();
   PvrdLink(const PvrdLink&) = delete;
   PvrdLink& operator=(const PvrdLink&) = delete;
@@ -34,8 +42,16 @@ class PvrdLink {
   void close();
 
  private:
+  // Writes everything the channel has for the socket; a failed write
+  // closes the link.
+  void flush();
+  // Reads what the socket has (waiting up to timeoutMs, -1 for ever) into
+  // the channel. False when the link closed or the channel failed.
+  bool readSome(int timeoutMs);
+
   int fd_ = -1;
   bool open_ = false;
+  std::unique_ptr<proto::SecureChannel> channel_;
   proto::FrameDecoder decoder_;
 };
 

@@ -43,12 +43,9 @@ int runServer(const ServerOptions& options) {
   std::unique_ptr<PvrdLink> link;
   if (world.rank() == 0) {
     try {
-      link = std::make_unique<PvrdLink>(options.host, options.port);
-      // The first frame, before anything else: pvrd relays nothing until it
-      // has checked the secret, and refuses an empty one.
-      if (secret.empty())
-        std::fprintf(stderr, "pvr-node: rank 0: %s is not set (pvrd sets it for the job it launches); "
-                     "the connect-back will be refused\n", proto::kJobSecretVariable);
+      // The secure channel keyed by the secret, then the first frame:
+      // pvrd relays nothing until it has checked both.
+      link = std::make_unique<PvrdLink>(options.host, options.port, secret);
       link->send(proto::JobHello{secret}, 0);
     } catch (const Error& e) {
       std::fprintf(stderr, "pvr-node: rank 0: %s\n", e.what());

@@ -29,6 +29,12 @@
 
 namespace pvr::proto {
 
+// The purposes the channel is keyed for (SecureChannel's `purpose`): a
+// client's connection to pvrd, keyed by the token; the master's
+// connect-back to its session handler, keyed by the job secret.
+inline constexpr std::string_view kClientPurpose = "client";
+inline constexpr std::string_view kConnectBackPurpose = "connect-back";
+
 class SecureChannel {
  public:
   enum class Role { kClient, kServer };

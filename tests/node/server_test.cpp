@@ -35,6 +35,7 @@
 #include "pvr_protocol.h"
 #include "raycast/raycaster.h"
 #include "scene.h"
+#include "secure_channel.h"
 #include "strategy.h"
 #include "thread_pool.h"
 
@@ -120,8 +121,10 @@ struct Launch {
   bool hiddenFromLastRank = false;
 };
 
-// The handler's side of one job. The constructor checks the master's
-// first frame: JobHello with the secret the job was given.
+// The handler's side of one job, as pvrd's: every byte inside the secure
+// channel keyed by the job secret. The constructor checks the handshake
+// and the master's first frame: JobHello with the secret the job was
+// given. Without a secret the master refuses to connect at all.
 class Job {
  public:
   // `extra`: more pvr-node options.
@@ -170,6 +173,9 @@ class Job {
       ::_exit(127);
     }
     ::setpgid(pid_, pid_);
+    if (!launch.secret) return;
+    channel_ = std::make_unique<proto::SecureChannel>(proto::SecureChannel::Role::kServer, *launch.secret,
+                                                      proto::kConnectBackPurpose);
     pollfd p{listen_, POLLIN, 0};
     REQUIRE(::poll(&p, 1, 60000) == 1);
     fd_ = ::accept4(listen_, nullptr, nullptr, SOCK_CLOEXEC);
@@ -179,7 +185,8 @@ class Job {
     REQUIRE(hello);
     REQUIRE(std::holds_alternative<proto::JobHello>(hello->message));
     CHECK(hello->info.requestId == 0);
-    CHECK(std::get<proto::JobHello>(hello->message).secret == launch.secret.value_or(""));
+    CHECK(std::get<proto::JobHello>(hello->message).secret == *launch.secret);
+    CHECK(channel_->established());
   }
   ~Job() {
     if (fd_ >= 0) ::close(fd_);
@@ -202,9 +209,14 @@ class Job {
   const fs::path& dumpDir() const { return dumpDir_; }
 
   std::uint32_t send(const proto::Message& m) {
-    const auto bytes = proto::encode(m, ++id_, proto::kFlagFinal);
-    REQUIRE(::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL) == ssize_t(bytes.size()));
+    REQUIRE_FALSE(channel_->send(proto::encode(m, ++id_, proto::kFlagFinal)));
+    flush();
     return id_;
+  }
+  // True when a connection came to the handler's socket within `seconds`.
+  bool connected(int seconds) {
+    pollfd p{listen_, POLLIN, 0};
+    return fd_ >= 0 || ::poll(&p, 1, seconds * 1000) == 1;
   }
   // The next message from the master; nullopt when the connection ended.
   std::optional<proto::Decoded> receive(int timeoutSeconds = 60) {
@@ -219,7 +231,10 @@ class Job {
       std::uint8_t buf[1 << 16];
       const ssize_t n = ::read(fd_, buf, sizeof buf);
       if (n <= 0) return std::nullopt;
-      decoder_.feed(std::span(buf, std::size_t(n)));
+      const auto failure = channel_->receive(std::span(buf, std::size_t(n)));
+      flush();
+      if (failure) FAIL("secure channel: " << failure->text);
+      decoder_.feed(channel_->takeIncoming());
     }
   }
   template <typename T>
@@ -253,7 +268,13 @@ class Job {
   }
 
  private:
+  void flush() {
+    const std::vector<std::uint8_t> bytes = channel_->takeOutgoing();
+    REQUIRE(::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL) == ssize_t(bytes.size()));
+  }
+
   int listen_ = -1, fd_ = -1;
+  std::unique_ptr<proto::SecureChannel> channel_;
   pid_t pid_ = -1;
   bool reaped_ = false;
   std::uint32_t id_ = 0;
@@ -706,13 +727,11 @@ TEST_CASE_METHOD(Fixture, "scene patches are checked whole before and after the 
   CHECK(job.close());
 }
 
-TEST_CASE_METHOD(Fixture, "without PVR_JOB_SECRET the master still sends JobHello first, with an empty secret") {
-  // The constructor checks the empty secret; pvrd would refuse it and
-  // close, this handler goes on to show the job is otherwise the same.
+TEST_CASE_METHOD(Fixture, "without PVR_JOB_SECRET the master does not connect back, and the job ends") {
+  // No secret, no key for the secure channel: nothing to connect with.
   Job job(2, {}, {.secret = std::nullopt});
-  job.send(proto::SessionOpen{2, {}, ""});
-  job.expect<proto::SessionReady>();
-  CHECK(job.close());
+  CHECK(job.reap(30));
+  CHECK_FALSE(job.connected(0));
 }
 
 TEST_CASE_METHOD(Fixture, "a rank whose host lacks the data names its host and the file, and the session serves on") {
