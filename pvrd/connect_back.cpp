@@ -10,8 +10,8 @@
 namespace pvr::daemon {
 namespace {
 
-// A connect-back must show its JobHello this soon (the real master sends it
-// right after connecting).
+// A connect-back must complete the handshake and show its JobHello this
+// soon (the real master does both right after connecting).
 constexpr double kJobHelloSeconds = 5;
 // Connections on trial at once; a flood beyond it refuses the oldest, so
 // silent connections cannot keep the real master out.
@@ -54,11 +54,23 @@ std::optional<ConnectBack::Master> ConnectBack::serve(std::span<const pollfd> po
       refuse(t, "closed before its JobHello");
       continue;
     }
-    auto result = t.check.feed(std::span(buf, std::size_t(got)));
+    const auto failure = t.channel->receive(std::span(buf, std::size_t(got)));
+    std::string error;
+    // Handshake replies, or the alert that says why we stop: a few hundred
+    // bytes into a fresh socket's buffer.
+    if (!writeAll(t.fd, t.channel->takeOutgoing(), error)) {
+      refuse(t, "write failed: " + error);
+      continue;
+    }
+    if (failure) {
+      refuse(t, failure->text);
+      continue;
+    }
+    auto result = t.check.feed(t.channel->takeIncoming());
     if (auto* refused = std::get_if<JobHelloCheck::Refused>(&result)) {
       refuse(t, refused->reason);
     } else if (auto* accepted = std::get_if<JobHelloCheck::Accepted>(&result)) {
-      master = Master{std::exchange(t.fd, -1), t.peer, std::move(accepted->rest)};
+      master = Master{std::exchange(t.fd, -1), t.peer, std::move(t.channel), std::move(accepted->rest)};
     }
   }
   for (Trial& t : trials_)
@@ -79,7 +91,10 @@ std::optional<ConnectBack::Master> ConnectBack::serve(std::span<const pollfd> po
         refuse(trials_.front(), "too many connect-backs on trial");
         trials_.erase(trials_.begin());
       }
-      trials_.push_back({fd, peerName(fd), JobHelloCheck(secret_), now + kJobHelloSeconds});
+      trials_.push_back({fd, peerName(fd),
+                         std::make_unique<proto::SecureChannel>(proto::SecureChannel::Role::kServer, secret_,
+                                                                proto::kConnectBackPurpose),
+                         JobHelloCheck(secret_), now + kJobHelloSeconds});
     }
   }
   return std::nullopt;

@@ -1,19 +1,23 @@
 // Where a session's master rank connects back: a socket listening on the
-// advertised address (any port) and the connections that have yet to prove,
-// with a JobHello and the session's secret (job_hello_check.h), that they
-// are the job this session launched. Refused ones are logged in one line
-// and closed; the listening goes on until one proves itself.
+// advertised address (any port) and the connections that have yet to prove
+// that they are the job this session launched: first the secure channel's
+// handshake keyed by the session's secret (only a holder of the secret
+// completes it), then, inside it, a JobHello with the secret
+// (job_hello_check.h). Refused ones are logged in one line and closed; the
+// listening goes on until one proves itself.
 #pragma once
 
 #include <poll.h>
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "job_hello_check.h"
+#include "secure_channel.h"
 
 namespace pvr::daemon {
 
@@ -34,10 +38,12 @@ class ConnectBack {
   // connections on trial.
   std::vector<pollfd> pollFds() const;
 
-  // The master's proven connection and the bytes that followed its JobHello.
+  // The master's proven connection, its channel (every later byte goes
+  // through it) and the plaintext that followed its JobHello.
   struct Master {
     int fd = -1;
     std::string peer;
+    std::unique_ptr<proto::SecureChannel> channel;
     std::vector<std::uint8_t> rest;
   };
   // Serves what poll() reported for pollFds() (same order): accepts, reads,
@@ -52,6 +58,7 @@ class ConnectBack {
   struct Trial {
     int fd;
     std::string peer;
+    std::unique_ptr<proto::SecureChannel> channel;
     JobHelloCheck check;
     double deadline;
   };

@@ -45,6 +45,10 @@ class Session {
   void onClient(proto::Decoded frame);
   void openSession(const proto::SessionOpen& open, std::uint32_t id);
   void onMaster(proto::RelayItem item);
+  // Plaintext for the master, through its secure channel.
+  void writeMaster(std::span<const std::uint8_t> plain);
+  // What the master's socket gave: decrypted, then relayed.
+  void onMasterCiphertext(std::span<const std::uint8_t> bytes);
   void onMasterBytes(std::span<const std::uint8_t> bytes);
   void adoptMaster(ConnectBack::Master master, double now);
   void refuseMasterFrame(const proto::RefusedFrame& refused);
@@ -59,6 +63,7 @@ class Session {
   const DaemonOptions& opt_;
   int client_;
   int master_ = -1;
+  std::unique_ptr<proto::SecureChannel> masterChannel_;  // with master_: every byte to and from it
   std::unique_ptr<Launcher> launcher_;       // while a job runs
   std::unique_ptr<ConnectBack> connectBack_;  // until the master proved itself
   double masterDeadline_ = 0;                // 0: none (waiting in a batch queue)
@@ -105,8 +110,22 @@ void Session::forward(const proto::Message& m, std::uint32_t id) {
     pendingToMaster_.push_back(std::move(bytes));
     return;
   }
+  writeMaster(bytes);
+}
+
+void Session::writeMaster(std::span<const std::uint8_t> plain) {
+  if (auto failure = masterChannel_->send(plain)) return jobEnded("secure channel to the master: " + failure->text);
   std::string error;
-  if (!writeAll(master_, bytes, error)) jobEnded("master write failed: " + error);
+  if (!writeAll(master_, masterChannel_->takeOutgoing(), error)) jobEnded("master write failed: " + error);
+}
+
+void Session::onMasterCiphertext(std::span<const std::uint8_t> bytes) {
+  const auto failure = masterChannel_->receive(bytes);
+  std::string error;
+  if (!writeAll(master_, masterChannel_->takeOutgoing(), error)) return jobEnded("master write failed: " + error);
+  if (failure) return jobEnded("secure channel to the master: " + failure->text);
+  const std::vector<std::uint8_t> plain = masterChannel_->takeIncoming();
+  if (!plain.empty()) onMasterBytes(plain);
 }
 
 void Session::onClient(proto::Decoded frame) {
@@ -239,12 +258,12 @@ void Session::refuseMasterFrame(const proto::RefusedFrame& refused) {
 
 void Session::adoptMaster(ConnectBack::Master master, double now) {
   master_ = master.fd;
+  masterChannel_ = std::move(master.channel);
   connectBack_.reset();
   masterDeadline_ = 0;
   log("master connected from " + master.peer + " after " + std::to_string(now - launchedAt_) + " s");
-  std::string error;
   while (!pendingToMaster_.empty() && !done_) {
-    if (!writeAll(master_, pendingToMaster_.front(), error)) jobEnded("master write failed: " + error);
+    writeMaster(pendingToMaster_.front());
     pendingToMaster_.pop_front();
   }
   if (!done_ && !master.rest.empty()) onMasterBytes(master.rest);
@@ -424,7 +443,7 @@ int Session::run() {
         jobEnded("the master rank's connection closed");
         break;
       }
-      onMasterBytes(std::span(buf.data(), std::size_t(got)));
+      onMasterCiphertext(std::span(buf.data(), std::size_t(got)));
     }
     if (launcher_ && !done_ && launcher_->exited()) jobEnded(launcher_->exitText());
     if (launcher_ && !done_ && master_ < 0 && masterDeadline_ > 0 && now > masterDeadline_)
