@@ -14,7 +14,10 @@
 #include <string>
 #include <thread>
 
+#include <memory>
+
 #include "fake_master.h"
+#include "secure_channel.h"
 
 namespace proto = pvr::proto;
 using namespace pvr::daemon::testing;
@@ -22,14 +25,38 @@ using namespace pvr::daemon::testing;
 namespace {
 
 int gSocket = -1;
+std::unique_ptr<proto::SecureChannel> gChannel;  // null: plain bytes (the "none" trial)
 
-void sendBytes(std::span<const std::uint8_t> bytes) {
+void writeRaw(std::span<const std::uint8_t> bytes) {
   std::size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n = ::send(gSocket, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
     if (n <= 0) std::exit(0);  // pvrd went away
     done += std::size_t(n);
   }
+}
+
+// Plaintext for pvrd, through the channel when there is one.
+void sendBytes(std::span<const std::uint8_t> bytes) {
+  if (!gChannel) return writeRaw(bytes);
+  if (gChannel->send(bytes)) std::exit(0);
+  writeRaw(gChannel->takeOutgoing());
+}
+
+// The channel's handshake keyed by `secret`; false when pvrd refuses it.
+bool handshake(const std::string& secret) {
+  gChannel = std::make_unique<proto::SecureChannel>(proto::SecureChannel::Role::kClient, secret,
+                                                    proto::kConnectBackPurpose);
+  writeRaw(gChannel->takeOutgoing());
+  std::uint8_t buf[4096];
+  while (!gChannel->established()) {
+    const ssize_t n = ::read(gSocket, buf, sizeof buf);
+    if (n <= 0) return false;
+    const auto failure = gChannel->receive(std::span(buf, std::size_t(n)));
+    writeRaw(gChannel->takeOutgoing());
+    if (failure) return false;
+  }
+  return true;
 }
 
 void send(const proto::Message& m, std::uint32_t id, bool final = true) {
@@ -98,10 +125,17 @@ void tryRefusedConnectBacks(const std::string& host, int port) {
     // A silent connection is never closed here: it stays open while the
     // master connects.
     gSocket = connectTo(host, port);
+    gChannel.reset();
     if (trial == kTrialSilent) continue;
-    if (trial == kTrialWrongSecret) send(proto::JobHello{std::string(kWrongSecret)}, 0);
-    else if (trial == kTrialNoSecret) send(proto::JobHello{""}, 0);
-    else send(proto::SessionReady{2, {}}, 0);
+    const char* secret = std::getenv("PVR_JOB_SECRET");
+    if (trial == kTrialWrongSecret) {
+      handshake(std::string(kWrongSecret));
+    } else if (trial == kTrialNoSecret) {
+      send(proto::JobHello{""}, 0);
+    } else if (handshake(secret ? secret : "")) {
+      if (trial == kTrialWrongJobHello) send(proto::JobHello{std::string(kWrongSecret)}, 0);
+      else send(proto::SessionReady{2, {}}, 0);
+    }
     expectClosed(gSocket, trial);
   }
 }
@@ -122,6 +156,7 @@ int main(int argc, char** argv) {
   tryRefusedConnectBacks(host, port);
   gSocket = connectTo(host, port);
   const char* secret = std::getenv("PVR_JOB_SECRET");
+  if (!handshake(secret ? secret : "")) return 1;
   send(proto::JobHello{secret ? secret : ""}, 0);
   proto::FrameDecoder decoder;
   std::string script(kScriptGood);
@@ -129,7 +164,8 @@ int main(int argc, char** argv) {
   for (;;) {
     const ssize_t n = ::read(gSocket, buf.data(), buf.size());
     if (n <= 0) return 0;
-    decoder.feed(std::span(buf.data(), std::size_t(n)));
+    if (gChannel->receive(std::span(buf.data(), std::size_t(n)))) return 1;
+    decoder.feed(gChannel->takeIncoming());
     while (auto d = decoder.pop()) {
       const std::uint32_t id = d->info.requestId;
       if (const auto* open = std::get_if<proto::SessionOpen>(&d->message)) {

@@ -7,9 +7,11 @@
 // Before that it can try connect-backs pvrd must refuse, listed in the
 // environment variable kTrialsVariable (pvrd passes its environment on),
 // comma-separated, in order: kTrialWrongSecret, kTrialNoSecret,
-// kTrialOtherFrame each wait until the handler closes them (the fake
-// master gives up with exit status 3 after 30 s); a kTrialSilent
-// connection stays open, saying nothing, while the others go on.
+// kTrialWrongJobHello, kTrialOtherFrame each wait until the handler closes
+// them (the fake master gives up with exit status 3 after 30 s); a
+// kTrialSilent connection stays open, saying nothing, while the others go
+// on. Like the real master, it talks inside the secure channel keyed by
+// PVR_JOB_SECRET (docs/protocol.md, "The secure channel").
 #pragma once
 
 #include <cstdint>
@@ -30,15 +32,18 @@ inline constexpr std::string_view kScriptInconsistent = "inconsistent";
 inline constexpr std::string_view kScriptGarbage = "garbage";
 
 inline constexpr const char* kTrialsVariable = "PVR_FAKE_MASTER_TRIALS";
-// JobHello with a secret that is not the session's.
+// The secure channel keyed by a secret that is not the session's.
 inline constexpr std::string_view kTrialWrongSecret = "wrong";
-// JobHello with an empty secret.
+// No secure channel: a plain JobHello with an empty secret.
 inline constexpr std::string_view kTrialNoSecret = "none";
-// A first frame other than JobHello.
+// The right channel, then a JobHello with a wrong secret inside it.
+inline constexpr std::string_view kTrialWrongJobHello = "wronghello";
+// The right channel, then a first frame other than JobHello.
 inline constexpr std::string_view kTrialOtherFrame = "other";
 // Connected, nothing sent.
 inline constexpr std::string_view kTrialSilent = "silent";
-// The wrong secret kTrialWrongSecret sends, with bytes the log must mask.
+// The wrong secret kTrialWrongSecret and kTrialWrongJobHello use, with
+// bytes the log must mask.
 inline constexpr std::string_view kWrongSecret = "\x01wrong\x7f";
 
 // The good frame: a 64 x 48 RGBA gradient, zlib-compressed by the codec.

@@ -40,11 +40,12 @@ void checkSecretOnlyInEnvironment(const fs::path& dataDir, pid_t launched) {
 
 }  // namespace
 
-TEST_CASE("connect-backs with a wrong secret, none, another frame or silence are refused and logged, and the master with the secret opens the session") {
+TEST_CASE("connect-backs keyed by a wrong secret, without the channel, with a wrong JobHello, another frame or silence are refused and logged, and the master with the secret opens the session") {
   namespace fake = pvr::daemon::testing;
   const fs::path dir = makeDataDir("secret");
   const std::string trials = std::string(fake::kTrialSilent) + "," + std::string(fake::kTrialWrongSecret) + "," +
-                             std::string(fake::kTrialNoSecret) + "," + std::string(fake::kTrialOtherFrame);
+                             std::string(fake::kTrialNoSecret) + "," + std::string(fake::kTrialWrongJobHello) + "," +
+                             std::string(fake::kTrialOtherFrame);
   Daemon d(dir, {"--mpirun", FAKE_MASTER_PATH}, {{fake::kTrialsVariable, trials}}, logPath("secret"));
   Client c(d.port);
   c.hello();
@@ -68,9 +69,11 @@ TEST_CASE("connect-backs with a wrong secret, none, another frame or silence are
   // One log line per refused connection, each naming its peer and reason.
   const std::string log = d.log();
   const auto refusals = linesContaining(log, "refused a connect-back from 127.0.0.1:");
-  CHECK(refusals.size() == 4);
+  CHECK(refusals.size() == 5);
+  // Keyed by another secret, or no channel at all: the handshake fails,
+  // before any frame.
+  CHECK(linesContaining(log, ": secure channel: the handshake failed (").size() == 2);
   CHECK(linesContaining(log, ": JobHello with a wrong secret; first bytes '").size() == 1);
-  CHECK(linesContaining(log, ": JobHello without a secret; first bytes '").size() == 1);
   CHECK(linesContaining(log, ": its first frame is SessionReady, not JobHello; first bytes '").size() == 1);
   CHECK(linesContaining(log, ": the master connected first; first bytes ''").size() == 1);
   // The wrong secret's control bytes are masked, never written raw.
