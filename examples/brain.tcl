@@ -2,7 +2,9 @@
 # host and dataset names, and scaled from 100 nodes (clusters of 16) to the
 # 8 ranks of one workstation (clusters of 1): it runs against a local pvrd.
 #
-#   pvrd --listen 127.0.0.1:7350 --data-dir /work/shared/data --max-ranks 8 &
+#   pvrd --listen 127.0.0.1:7350 --data-dir ../shared/data --max-ranks 8 &
+#
+# (README's pvrd line, which allows the 8 ranks this asks for.)
 #   pvrsh examples/brain.tcl ?HOST:PORT? ?DATASET?
 #
 # HOST:PORT comes from the first argument, else $PVR_SERVER, else

@@ -1,7 +1,9 @@
-# The demo: a session with 4 ranks renders a 36-frame rotation of a dataset
-# (the CT head when the catalog has it, else the first dataset) and writes
-# the frames into out/ (PNG, plus out/demo.mp4 when ffmpeg is installed).
-# pvrsh prints progress and, at the end, the per-frame timing table.
+# The demo: a session with 4 ranks renders a 36-frame shaded rotation of a
+# dataset (the CT head with the bone preset when the catalog has it, else
+# the first dataset) and writes the frames into out/ (PNG, plus
+# out/demo.mp4 when ffmpeg is installed). pvrsh prints progress and, at the
+# end, the per-frame timing table. Paths are the script's own: it runs
+# from any directory.
 #
 #   pvrsh examples/demo.tcl ?HOST:PORT? ?OUTDIR?
 #
@@ -10,6 +12,7 @@ set host [expr {[llength $argv] > 0 ? [lindex $argv 0] :
                 [info exists env(PVR_SERVER)] ? $env(PVR_SERVER) : "127.0.0.1:7350"}]
 set out [expr {[llength $argv] > 1 ? [lindex $argv 1] : "out"}]
 file mkdir $out
+set here [file dirname [file normalize [info script]]]
 
 pvr_session :demo
 :demo open $host -ranks 4
@@ -21,9 +24,11 @@ foreach name $catalog {
 }
 puts stderr "demo: $dataset on $host, 4 ranks, 36 frames into $out/"
 
-:demo set -dataset $dataset -imagesz 512,512
-if {[string match -nocase *ct_head* $dataset] && [file exists examples/presets/ct_bone.json]} {
-    :demo set -tfpreset examples/presets/ct_bone.json
+# Shaded, with the lighting of examples/scenes/ct_head_bone.json, so the
+# frames look as pvr-render's image of that scene does.
+:demo set -dataset $dataset -imagesz 512,512 -shading 1 -ambient 0.25 -diffuse 0.75 -specular 0.3 -shininess 24
+if {[string match -nocase *ct_head* $dataset]} {
+    :demo set -tfpreset [file join $here presets ct_bone.json]
 }
 :demo image file [file join $out demo.mp4]
 :demo render rotate 0,0,1 0,35:36

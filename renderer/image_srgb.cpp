@@ -12,11 +12,18 @@ std::uint8_t linearToSrgb8(double v) {
   return std::uint8_t(std::lround(e * 255.0));
 }
 
+double srgbToLinear(double x) {
+  if (!(x > 0)) return 0;  // also NaN
+  return x <= 0.04045 ? x / 12.92 : std::pow((x + 0.055) / 1.055, 2.4);
+}
+
 std::vector<std::uint8_t> toSrgbRgba8(const Image& image, const std::array<double, 4>& background) {
   const int w = image.frameWidth(), h = image.frameHeight();
-  // The background is given straight; "over" needs it premultiplied.
+  // The background is given straight, in display sRGB; "over" needs it
+  // linear and premultiplied.
   const double bgA = background[3];
-  const double bg[4] = {background[0] * bgA, background[1] * bgA, background[2] * bgA, bgA};
+  const double bg[4] = {srgbToLinear(background[0]) * bgA, srgbToLinear(background[1]) * bgA,
+                        srgbToLinear(background[2]) * bgA, bgA};
   std::vector<std::uint8_t> out(std::size_t(w) * std::size_t(h) * 4);
   std::uint8_t* o = out.data();
   for (int y = 0; y < h; ++y)

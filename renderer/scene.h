@@ -30,7 +30,10 @@ struct VolumeSpec {
   int timestep = 0;             // 0-based step of a time series (the scene's "timestep")
 };
 
-// One control point: scalar -> linear RGB colour and opacity (per unit_distance).
+// One control point: scalar -> colour and opacity (per unit_distance). The
+// colour is display sRGB (1 = white), as ParaView presets and colour
+// pickers mean it; the renderer converts it to linear light once
+// (evaluateMedium, transfer.h), so a swatch renders as it looks.
 struct TransferPoint {
   double scalar = 0;
   double r = 0, g = 0, b = 0;
@@ -71,7 +74,7 @@ inline constexpr int kMaxImageSide = 16384;
 struct ImageSpec {
   int width = 512;
   int height = 512;
-  std::array<double, 4> background{0, 0, 0, 1};  // straight (not premultiplied) RGBA
+  std::array<double, 4> background{0, 0, 0, 1};  // straight (not premultiplied) RGBA, colour in display sRGB
 };
 
 // The most samples a ray may take across the scene's domain: a step so

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "error.h"
+#include "image_srgb.h"
 
 namespace pvr::core {
 
@@ -50,8 +51,10 @@ struct TableDomain {
 }  // namespace
 
 Medium evaluateMedium(const TransferFunctionSpec& tf, double scalar) {
+  // Interpolated between the control points as given (display sRGB, as
+  // ParaView interpolates its RGB space), then converted to linear light.
   const TransferPoint p = interpolate(tf.points, scalar);
-  Medium m{p.r, p.g, p.b, 0};
+  Medium m{srgbToLinear(p.r), srgbToLinear(p.g), srgbToLinear(p.b), 0};
   const double a = std::clamp(p.opacity, 0.0, 1.0);
   // Opacity 1 is an infinite extinction; keep it finite but saturating so
   // 1 - exp(-tau h) rounds to 1 for any step a renderer uses.

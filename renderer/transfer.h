@@ -26,7 +26,7 @@ namespace pvr::core {
 // Extinction and colour of a transfer function at one scalar, in double:
 // the continuous model that references integrate and tables sample.
 struct Medium {
-  double r = 0, g = 0, b = 0;  // linear colour, not premultiplied
+  double r = 0, g = 0, b = 0;  // linear colour (the transfer function's sRGB decoded), not premultiplied
   double tau = 0;              // extinction per world unit: -ln(1 - a) / unit_distance
 };
 Medium evaluateMedium(const TransferFunctionSpec& tf, double scalar);

@@ -8,9 +8,10 @@
 // printing to stderr and returning NULL, which would leave our message
 // unable to say what is wrong.
 //
-// The grid is axis-aligned: spacing is |pixdim|, the origin the qform
-// offset (else the sform translation, else 0); rotations and flips are not
-// applied. A scl_slope other than 0 or 1 (or a nonzero scl_inter) makes the
+// Orientation: the qform (else the sform, else |pixdim| along the index
+// axes from 0) places the voxels in scanner space; flipped and permuted
+// axes are read in scanner order, an oblique rotation is shown on the
+// nearest axes and noted (orientation.h). A scl_slope other than 0 or 1 (or a nonzero scl_inter) makes the
 // volume float32 with the scaling applied, since the stored integers are
 // not the values the file means.
 //
@@ -26,6 +27,7 @@
 #include "byte_stream.h"
 #include "formats.h"
 #include "gzip_stream.h"
+#include "orientation.h"
 #include "raw_reader.h"
 #include "series.h"
 #include "source_util.h"
@@ -81,6 +83,7 @@ ScalarType niftiScalarType(const nifti_image& nim, const std::string& path) {
              " is not supported (UINT8, UINT16, INT16, FLOAT32)");
 }
 
+// The index grid: dims and |pixdim| (orientation comes from niftiFrame).
 GridGeometry niftiGrid(const nifti_image& nim, const std::string& path) {
   for (int d = 5; d <= 7; ++d)
     if (nim.dim[d] > 1)
@@ -90,11 +93,20 @@ GridGeometry niftiGrid(const nifti_image& nim, const std::string& path) {
   GridGeometry grid;
   grid.dims = {std::max(nim.nx, 1), std::max(nim.ny, 1), std::max(nim.nz, 1)};
   grid.spacing = {std::fabs(nim.dx), std::fabs(nim.dy), std::fabs(nim.dz)};
-  if (nim.qform_code > 0)
-    grid.origin = {nim.qoffset_x, nim.qoffset_y, nim.qoffset_z};
-  else if (nim.sform_code > 0)
-    grid.origin = {nim.sto_xyz.m[0][3], nim.sto_xyz.m[1][3], nim.sto_xyz.m[2][3]};
   return grid;
+}
+
+// Index to scanner space: the qform, else the sform, else the index grid.
+IndexFrame niftiFrame(const nifti_image& nim, const GridGeometry& grid) {
+  const mat44* m = nim.qform_code > 0 ? &nim.qto_xyz : nim.sform_code > 0 ? &nim.sto_xyz : nullptr;
+  IndexFrame frame;
+  if (!m) {
+    for (int a = 0; a < 3; ++a) frame.axes[std::size_t(a)][a] = grid.spacing[a];
+    return frame;
+  }
+  for (int a = 0; a < 3; ++a) frame.axes[std::size_t(a)] = Vec3{m->m[0][a], m->m[1][a], m->m[2][a]};
+  frame.origin = Vec3{m->m[0][3], m->m[1][3], m->m[2][3]};
+  return frame;
 }
 
 // Applies value = slope * stored + inter, turning the volume into float32.
@@ -145,7 +157,12 @@ std::unique_ptr<VolumeSource> openNifti(const std::string& path, const DataDirec
                                                                  &nifti_image_free);
   if (!nim) failAt(ErrorCode::kBadFile, path, "nifti_clib cannot read the NIfTI-1 header");
   const ScalarType type = niftiScalarType(*nim, path);
-  const GridGeometry grid = niftiGrid(*nim, path);
+  const GridGeometry indexGrid = niftiGrid(*nim, path);
+  const Orientation orientation = orientationOf(niftiFrame(*nim, indexGrid), indexGrid.dims, path);
+  // The voxels in file order: the index grid when they are reordered,
+  // else already the grid in space.
+  const GridGeometry grid = orientation.reorders() ? indexGrid : orientation.grid;
+  const std::string name = fileNameOf(path) + obliqueNote(orientation);
 
   // Step 3: the voxels start at vox_offset, in the file or in the gzip stream.
   RawLayout layout;
@@ -155,19 +172,20 @@ std::unique_ptr<VolumeSource> openNifti(const std::string& path, const DataDirec
   layout.bigEndian = nim->byteorder == kNiftiMsbFirst;
   const double slope = nim->scl_slope, inter = nim->scl_inter;
   const bool scaled = std::isfinite(slope) && std::isfinite(inter) && slope != 0 && (slope != 1 || inter != 0);
+  // Scaled, then shown in scanner space.
   const auto applyScaling = [&](std::unique_ptr<VolumeSource> stored) -> std::unique_ptr<VolumeSource> {
-    if (!scaled) return stored;
-    return std::make_unique<ScaledSource>(std::move(stored), slope, inter);
+    if (scaled) stored = std::make_unique<ScaledSource>(std::move(stored), slope, inter);
+    return reoriented(std::move(stored), orientation);
   };
   const std::int64_t timeSteps = nim->dim[0] >= 4 ? std::max<std::int64_t>(nim->dim[4], 1) : 1;
   if (timeSteps == 1)
-    return applyScaling(openRawVolume(fileNameOf(path), grid, type, std::move(layout), SizeRule::kAtLeast));
+    return applyScaling(openRawVolume(name, grid, type, std::move(layout), SizeRule::kAtLeast));
 
   // Step 4: a time series, the 3-D volumes one after another.
   const double dt = std::isfinite(nim->dt) && nim->dt > 0 ? nim->dt : 1.0;
   const double t0 = nim->dt > 0 && std::isfinite(nim->toffset) ? nim->toffset : 0.0;
   std::vector<SeriesStep> steps;
-  for (auto& step : openPackedSteps(fileNameOf(path), grid, type, layout, timeSteps, SizeRule::kAtLeast))
+  for (auto& step : openPackedSteps(name, grid, type, layout, timeSteps, SizeRule::kAtLeast))
     steps.push_back({t0 + double(steps.size()) * dt, applyScaling(std::move(step)),
                      "volume " + std::to_string(steps.size()), ""});
   return makeSeries(path, fileNameOf(path), std::move(steps));

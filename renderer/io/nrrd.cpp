@@ -15,6 +15,7 @@
 
 #include "byte_stream.h"
 #include "formats.h"
+#include "orientation.h"
 #include "nrrd_header.h"
 #include "raw_reader.h"
 #include "source_util.h"
@@ -98,7 +99,11 @@ std::unique_ptr<VolumeSource> openNrrd(const std::string& path, const DataDirect
     const std::uint64_t size = withHeaderNamed(layout, [&] { return fileSizeOf(layout.dataPath); });
     layout.offset = size >= start + data ? size - data : start;
   }
-  return openRawVolume(fileNameOf(path), h.grid, h.type, std::move(layout), SizeRule::kExact);
+  // Step: the space directions orient the grid (orientation.h).
+  if (!h.spaceDirections)
+    return openRawVolume(fileNameOf(path), h.grid, h.type, std::move(layout), SizeRule::kExact);
+  const Orientation o = orientationOf({*h.spaceDirections, h.grid.origin}, h.grid.dims, path);
+  return reoriented(openRawVolume(fileNameOf(path) + obliqueNote(o), h.grid, h.type, std::move(layout), SizeRule::kExact), o);
 }
 
 }  // namespace pvr::core

@@ -133,13 +133,16 @@ void parseSpaceDirections(ParseState& st, std::string_view v) {
   if (dirs.size() != 3)
     st.fail(ErrorCode::kBadFile, "space directions has " + std::to_string(dirs.size()) +
                                      " entries, need 3");
-  // The grid is axis-aligned: a direction contributes its length only.
+  // Lengths are the spacing; the directions themselves orient the grid (nrrd.cpp).
   Vec3 lengths;
+  std::array<Vec3, 3> directions;
   for (int a = 0; a < 3; ++a) {
     if (!dirs[a]) st.fail(ErrorCode::kUnsupported, "space directions: axis " + std::to_string(a) + " is 'none'");
     lengths[a] = length(*dirs[a]);
+    directions[std::size_t(a)] = *dirs[a];
   }
   st.directionLengths = lengths;
+  st.header.spaceDirections = directions;
 }
 void parseSpaceOrigin(ParseState& st, std::string_view v) {
   const auto origin = vectors(st, v, "space origin");

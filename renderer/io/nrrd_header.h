@@ -2,6 +2,7 @@
 // into what a 3D scalar volume needs. nrrd.cpp turns it into a data layout.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -16,6 +17,9 @@ enum class NrrdEncoding : std::uint8_t { kRaw, kGzip };
 struct NrrdHeader {
   ScalarType type = ScalarType::kUInt8;
   GridGeometry grid;                  // sizes; spacing and origin as stated, else 1 and 0
+  // "space directions" as written: the space step of one node along each
+  // index axis (grid.spacing holds their lengths); absent without the field.
+  std::optional<std::array<Vec3, 3>> spaceDirections;
   NrrdEncoding encoding = NrrdEncoding::kRaw;
   std::optional<bool> bigEndian;      // absent: the header has no "endian" field
   std::string dataFile;               // "data file:" as written; empty when attached

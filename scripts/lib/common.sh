@@ -17,9 +17,13 @@ PVR_PACKAGES=(
   iproute2 openssh-server munge slurm-wlm
 )
 
+# Only the demo: ffmpeg turns its frames into an MP4 and a GIF.
+PVR_DEMO_PACKAGES=(ffmpeg)
+
+# Installs what is missing of PVR_PACKAGES and the packages given.
 pvr_install_missing() {
   local missing=()
-  for p in "${PVR_PACKAGES[@]}"; do
+  for p in "${PVR_PACKAGES[@]}" "$@"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   [ ${#missing[@]} -eq 0 ] && return 0

@@ -10,9 +10,13 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <nlohmann/json.hpp>
+
 #include "error.h"
 #include "image.h"
 #include "image_io.h"
+#include "paraview_preset.h"
+#include "reference.h"
 
 using namespace pvr::core;
 namespace fs = std::filesystem;
@@ -132,10 +136,11 @@ TEST_CASE("PNG over a translucent background keeps straight alpha", "[image]") {
   CHECK(std::vector<std::uint8_t>(b.begin(), b.begin() + 4) == std::vector<std::uint8_t>{188, 188, 188, 128});
   CHECK(std::vector<std::uint8_t>(b.begin() + 4, b.end()) == std::vector<std::uint8_t>{0, 0, 0, 0});
 
-  // An opaque background shows through fully where the image is empty.
+  // An opaque background shows through fully where the image is empty, as
+  // the display colour it was given (0.2 -> 51).
   writeImage(image, {0.2, 0.4, 0.6, 1.0}, path);
   const std::vector<std::uint8_t> c = readPngBytes(path, w, h);
-  CHECK(std::vector<std::uint8_t>(c.begin() + 4, c.end()) == std::vector<std::uint8_t>{124, 170, 203, 255});
+  CHECK(std::vector<std::uint8_t>(c.begin() + 4, c.end()) == std::vector<std::uint8_t>{51, 102, 153, 255});
 }
 
 TEST_CASE("image file errors name the path", "[image]") {
@@ -214,4 +219,31 @@ TEST_CASE("compareImages reports RMSE, PSNR and max error over the full frame", 
   CHECK(std::isinf(compareImages(a, b).maxAbs));
 
   CHECK_THROWS_AS(compareImages(Image::fullFrame(2, 2), b), pvr::Error);
+}
+
+// Transfer-function colours are display sRGB, as ParaView and colour
+// pickers mean them: an opaque slab of ParaView's Cool to Warm red end
+// (180, 4, 38) comes out of the PNG as (180, 4, 38), not lighter.
+TEST_CASE("an opaque slab through a preset colour writes that colour to the PNG", "[image][colour]") {
+  const nlohmann::json preset = {{"Name", "Cool to Warm, red end"},
+                                 {"RGBPoints", {0, 0.705882, 0.0156863, 0.14902, 1, 0.705882, 0.0156863, 0.14902}},
+                                 {"Points", {0, 1, 0.5, 0, 1, 1, 0.5, 0}}};
+  TransferFunctionSpec tf = paraViewPresetFromJson(preset, "preset");
+  tf.unitDistance = 1;
+  const GridGeometry grid = cubeGrid(8);
+  const Brick slab = makeVolume(grid, ScalarType::kFloat32, [](Vec3) { return 0.5; });
+  BrickRenderer renderer(slab);
+  const RenderOptions options = makeOptions(0.5);
+  renderer.classify(tf, options);
+  ThreadPool pool(1);
+  const Camera camera = makeCamera(Projection::kOrthographic, {3.5, 3.5, -10}, {3.5, 3.5, 3.5}, {0, 1, 0}, 4, 8, 8);
+  const std::string path = scratch("swatch.png").string();
+  writeImage(renderer.render(camera, options, pool), {0, 0, 0, 1}, path);
+  int w = 0, h = 0;
+  const std::vector<std::uint8_t> b = readPngBytes(path, w, h);
+  const std::uint8_t* centre = b.data() + (std::size_t(h / 2) * std::size_t(w) + std::size_t(w / 2)) * 4;
+  CHECK(std::abs(int(centre[0]) - 180) <= 1);
+  CHECK(std::abs(int(centre[1]) - 4) <= 1);
+  CHECK(std::abs(int(centre[2]) - 38) <= 1);
+  CHECK(int(centre[3]) == 255);
 }

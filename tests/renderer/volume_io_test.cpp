@@ -172,12 +172,7 @@ TEST_CASE("nii takes the origin from the sform when there is no qform", "[io]") 
   const std::string dir = scratchDir("nii_sform");
   const TestVolume v = testVolume(ScalarType::kUInt8);
   nifti_1_header h = niftiHeader(v, {});
-  h.qform_code = 0;
-  h.sform_code = 2;
-  const float srow[3][4] = {{0.5f, 0, 0, 7.5f}, {0, 0.75f, 0, -2.0f}, {0, 0, 2.25f, 3.0f}};
-  std::memcpy(h.srow_x, srow[0], sizeof h.srow_x);
-  std::memcpy(h.srow_y, srow[1], sizeof h.srow_y);
-  std::memcpy(h.srow_z, srow[2], sizeof h.srow_z);
+  setSform(h, {{0.5f, 0, 0, 7.5f}, {0, 0.75f, 0, -2.0f}, {0, 0, 2.25f, 3.0f}});
   writeBytes(dir + "/s.nii", niftiBytes(h, v, false));
   const auto src = openVolumeFile(dir + "/s.nii");
   CHECK(src->grid().origin == Vec3{7.5, -2.0, 3.0});

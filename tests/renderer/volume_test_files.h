@@ -266,6 +266,15 @@ inline nifti_1_header niftiHeader(const TestVolume& v, const NiftiOptions& o) {
   return h;
 }
 
+// Replaces the qform with an sform whose rows are `rows` (scanner = rows * (i, j, k, 1)).
+inline void setSform(nifti_1_header& h, const float (&rows)[3][4]) {
+  h.qform_code = 0;
+  h.sform_code = 2;
+  std::memcpy(h.srow_x, rows[0], sizeof h.srow_x);
+  std::memcpy(h.srow_y, rows[1], sizeof h.srow_y);
+  std::memcpy(h.srow_z, rows[2], sizeof h.srow_z);
+}
+
 inline std::vector<std::byte> niftiBytes(nifti_1_header h, const TestVolume& v, bool bigEndian) {
   if (bigEndian) swapHeader(h);
   const auto* p = reinterpret_cast<const std::byte*>(&h);
