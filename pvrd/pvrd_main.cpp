@@ -13,6 +13,7 @@
 
 #include "advertise.h"
 #include "auth.h"
+#include "token_file.h"
 #include "options.h"
 #include "pvr_protocol.h"
 #include "session.h"
@@ -66,12 +67,12 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (!options->tokenFile.empty()) {
-    const auto token = readToken(options->tokenFile, error);
-    if (!token) {
-      std::fprintf(stderr, "pvrd: %s\n", error.c_str());
+    const auto token = pvr::proto::readTokenFile(options->tokenFile);
+    if (const auto* refused = std::get_if<pvr::proto::TokenFileError>(&token)) {
+      std::fprintf(stderr, "pvrd: %s\n", refused->text.c_str());
       return 2;
     }
-    config.token = *token;
+    config.token = std::get<std::string>(token);
   }
   if (::pipe2(gSignalPipe, O_CLOEXEC | O_NONBLOCK) != 0) {
     std::fprintf(stderr, "pvrd: %s\n", errnoText("pipe2").c_str());

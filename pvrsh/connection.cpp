@@ -120,13 +120,31 @@ void Connection::finishConnect() {
 bool Connection::send(const proto::Message& message, std::uint32_t requestId) {
   if (state_ == State::kFailed) return false;
   const std::vector<std::uint8_t> frame = proto::encode(message, requestId, 0);
+  if (!channel_) {
+    queue(frame);
+  } else if (const auto failure = channel_->send(frame)) {
+    fail({"PVR", "AUTH", "FAILED"}, "secure channel to " + peer_ + ": " + failure->text);
+    return false;
+  } else {
+    queue(channel_->takeOutgoing());
+  }
+  if (state_ == State::kConnected) writeSome();
+  return state_ != State::kFailed;
+}
+
+void Connection::queue(std::span<const std::uint8_t> bytes) {
   if (outDone_ == out_.size()) {
     out_.clear();
     outDone_ = 0;
   }
-  out_.insert(out_.end(), frame.begin(), frame.end());
+  out_.insert(out_.end(), bytes.begin(), bytes.end());
+}
+
+void Connection::startSecure(const std::string& token) {
+  channel_ = std::make_unique<proto::SecureChannel>(proto::SecureChannel::Role::kClient, token,
+                                                    proto::kClientPurpose);
+  queue(channel_->takeOutgoing());  // the ClientHello
   if (state_ == State::kConnected) writeSome();
-  return state_ != State::kFailed;
 }
 
 void Connection::writeSome() {
@@ -153,7 +171,18 @@ void Connection::readSome() {
   std::uint8_t buf[256 << 10];
   const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
   if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) return;
-  if (n > 0) decoder_.feed(std::span<const std::uint8_t>(buf, std::size_t(n)));
+  if (n > 0 && !channel_) decoder_.feed(std::span<const std::uint8_t>(buf, std::size_t(n)));
+  if (n > 0 && channel_) {
+    const auto failure = channel_->receive(std::span<const std::uint8_t>(buf, std::size_t(n)));
+    queue(channel_->takeOutgoing());  // handshake replies, or the alert that says why we stop
+    writeSome();
+    if (state_ != State::kConnected) return;
+    if (failure) {
+      fail({"PVR", "AUTH", "FAILED"}, "cannot authenticate with " + peer_ + ": " + failure->text);
+      return;
+    }
+    decoder_.feed(channel_->takeIncoming());
+  }
   const std::shared_ptr<bool> alive = alive_;
   while (auto message = decoder_.pop()) {
     listener_.onMessage(*message);

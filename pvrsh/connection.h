@@ -4,7 +4,9 @@
 // (Tcl_CreateFileHandler), so any number of connections and a Tk GUI stay
 // live at once. Bytes in go through a FrameDecoder; each decoded message is
 // handed to the Listener. Bytes out are queued and written as the socket
-// accepts them. The connection never blocks the interpreter.
+// accepts them. The connection never blocks the interpreter. Once
+// startSecure() is called every byte in and out goes through a
+// SecureChannel keyed by the token (docs/protocol.md, "The secure channel").
 #pragma once
 
 #include <tcl.h>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "pvr_protocol.h"
+#include "secure_channel.h"
 #include "tcl_util.h"
 
 namespace pvr::tcl {
@@ -44,6 +47,12 @@ class Connection {
   // once the connection has failed or closed (the frame is dropped).
   bool send(const proto::Message& message, std::uint32_t requestId);
 
+  // Starts the secure channel keyed by `token`: the server asked for it in
+  // Welcome. Frames sent from now on wait in the channel until its
+  // handshake completes; a handshake the server fails (another token, or a
+  // server that is not pvrd) fails the connection with {PVR AUTH FAILED}.
+  void startSecure(const std::string& token);
+
   bool connected() const { return state_ == State::kConnected; }
   bool failed() const { return state_ == State::kFailed; }
 
@@ -58,6 +67,8 @@ class Connection {
   void updateMask();
   void fail(std::vector<std::string> code, const std::string& message);
   void closeSocket();
+  // Appends bytes for the socket to the queue.
+  void queue(std::span<const std::uint8_t> bytes);
 
   Listener& listener_;
   std::string peer_;  // "host:port" for messages
@@ -67,6 +78,7 @@ class Connection {
   Tcl_TimerToken timer_ = nullptr;        // connect timeout
   std::vector<std::uint8_t> out_;         // bytes queued for the socket
   std::size_t outDone_ = 0;               // bytes of out_ already written
+  std::unique_ptr<proto::SecureChannel> channel_;  // after startSecure()
   proto::FrameDecoder decoder_;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);  // false once destroyed
 };

@@ -1,31 +1,22 @@
-// Session::open: connect, Hello and Welcome, the token challenge when the
-// server asks (HMAC-SHA256 of its nonce keyed with the shared token), and
-// SessionOpen, which starts the MPI job (docs/protocol.md, "The
-// conversation"), printing the server's progress while a batch system
+// Session::open: connect, Hello and Welcome, the secure channel keyed by
+// the shared token when the server asks (docs/protocol.md, "The secure
+// channel"), and SessionOpen, which starts the MPI job (docs/protocol.md,
+// "The conversation"), printing the server's progress while a batch system
 // keeps the job queued.
-#include <openssl/evp.h>
-#include <openssl/hmac.h>
-
 #include <algorithm>
-#include <cctype>
-#include <fstream>
-#include <sstream>
 
 #include "session.h"
+#include "token_file.h"
 
 namespace pvr::tcl {
 namespace {
 
-// The shared token of a token file (trailing whitespace dropped).
+// The shared token of a token file (proto::readTokenFile's rules).
 std::string readToken(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw TclError({"PVR", "CONNECT", "TOKEN"}, "cannot read token file " + path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  std::string token = s.str();
-  while (!token.empty() && std::isspace(static_cast<unsigned char>(token.back()))) token.pop_back();
-  if (token.empty()) throw TclError({"PVR", "CONNECT", "TOKEN"}, "token file " + path + " is empty");
-  return token;
+  auto token = proto::readTokenFile(path);
+  if (const auto* refused = std::get_if<proto::TokenFileError>(&token))
+    throw TclError({"PVR", "CONNECT", "TOKEN"}, refused->text);
+  return std::get<std::string>(token);
 }
 
 // A SessionOpen's progress while the job waits for its ranks: one line on
@@ -77,23 +68,23 @@ void Session::open(const OpenRequest& request) {
       if (lastFailure_) throw *lastFailure_;
       throw TclError({"PVR", "CONNECT", "FAILED"}, "cannot connect to " + peer_);
     }
-    // Step 2: Hello, Welcome, and the token challenge when the server asks.
+    // Step 2: Hello, Welcome, and the secure channel when the server asks.
     const auto hello = query(proto::Hello{"pvrsh " PVR_PACKAGE_VERSION}, timeout);
     const auto* welcome = std::get_if<proto::Welcome>(&hello.front());
     if (!welcome) throw TclError({"PVR", "PROTOCOL", "UNEXPECTED_MESSAGE"}, peer_ + " did not answer Hello with Welcome");
     serverSoftware_ = welcome->software;
     maxRanks_ = welcome->maxRanks;
-    if (welcome->authRequired) {
-      const auto* challenge = hello.size() > 1 ? std::get_if<proto::AuthChallenge>(&hello[1]) : nullptr;
-      if (!challenge) throw TclError({"PVR", "PROTOCOL", "UNEXPECTED_MESSAGE"}, peer_ + " asked for a token but sent no challenge");
-      if (token.empty())
-        throw TclError({"PVR", "CONNECT", "TOKEN"}, peer_ + " requires a token: open with -token-file FILE");
-      proto::AuthResponse response;
-      unsigned int len = 0;
-      HMAC(EVP_sha256(), token.data(), int(token.size()), challenge->nonce.data(), challenge->nonce.size(),
-           response.mac.data(), &len);
-      query(response, timeout);
-    }
+    if (welcome->authRequired && token.empty())
+      throw TclError({"PVR", "CONNECT", "TOKEN"}, peer_ + " requires a token: open with -token-file FILE");
+    // A client with a token talks only to a server that proves it holds
+    // the token too: one that does not ask may be anyone.
+    if (!welcome->authRequired && !token.empty())
+      throw TclError({"PVR", "AUTH", "NOSERVERAUTH"},
+                     peer_ + " does not ask for a token, so it cannot prove it holds yours; not opening a session "
+                             "with -token-file to it (open without -token-file if it is a local pvrd without one)");
+    // Frames from here on wait in the channel until its handshake is done;
+    // SessionOpen's answer then arrives through it.
+    if (welcome->authRequired) conn_->startSecure(token);
     // Step 3: start the MPI job with the layout set so far.
     if (request.ranks > 0 && maxRanks_ > 0 && request.ranks > maxRanks_)
       throw TclError({"PVR", "ARGS", "RANKS"}, "-ranks " + std::to_string(request.ranks) + " is more than " + peer_ +

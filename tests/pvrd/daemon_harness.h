@@ -23,6 +23,7 @@
 #include <thread>
 
 #include "pvr_protocol.h"
+#include "secure_channel.h"
 
 namespace pvr::daemon::testing {
 
@@ -120,6 +121,11 @@ inline bool fileComesToHold(const fs::path& path, const std::string& text, doubl
 }
 
 using Environment = std::vector<std::pair<std::string, std::string>>;
+
+// A file for one test's pvrd log (Daemon's `log`), unique to this process.
+inline fs::path logPath(const std::string& tag) {
+  return fs::path(PVR_TEST_TMP) / ("pvrd_" + tag + "_" + std::to_string(::getpid()) + ".log");
+}
 
 // pvrd on 127.0.0.1:0 with `extra` options and `environment` added to the
 // test's; its log goes to `logFile` when one is named.
@@ -219,6 +225,8 @@ inline int connectTo(int port) {
 struct Client {
   int fd;
   proto::FrameDecoder decoder;
+  std::unique_ptr<proto::SecureChannel> channel;  // after secure()
+  std::optional<proto::ProtocolError> channelFailure;  // what the channel refused
   std::uint32_t nextId = 1;
   explicit Client(int port) : fd(connectTo(port)) {}
   ~Client() { closeNow(); }
@@ -228,8 +236,24 @@ struct Client {
   }
   std::uint32_t send(const proto::Message& m) {
     const auto bytes = proto::encode(m, nextId, 0);
-    REQUIRE(::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL) == ssize_t(bytes.size()));
+    if (channel) {
+      REQUIRE_FALSE(channel->send(bytes));
+      writeRaw(channel->takeOutgoing());
+    } else {
+      writeRaw(bytes);
+    }
     return nextId++;
+  }
+  void writeRaw(std::span<const std::uint8_t> bytes) {
+    if (bytes.empty()) return;
+    REQUIRE(::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL) == ssize_t(bytes.size()));
+  }
+  // As pvrsh after a Welcome that asks for a token: the secure channel
+  // keyed by `token`; frames sent from now on wait for its handshake.
+  void secure(const std::string& token) {
+    channel = std::make_unique<proto::SecureChannel>(proto::SecureChannel::Role::kClient, token,
+                                                     proto::kClientPurpose);
+    writeRaw(channel->takeOutgoing());
   }
   // The next message, or nullopt at end of stream or after `seconds`.
   std::optional<proto::Decoded> next(double seconds = 60) {
@@ -242,7 +266,14 @@ struct Client {
       std::uint8_t buf[65536];
       const ssize_t n = ::read(fd, buf, sizeof buf);
       if (n <= 0) return std::nullopt;
-      decoder.feed(std::span(buf, std::size_t(n)));
+      if (!channel) {
+        decoder.feed(std::span(buf, std::size_t(n)));
+        continue;
+      }
+      channelFailure = channel->receive(std::span(buf, std::size_t(n)));
+      writeRaw(channel->takeOutgoing());  // handshake replies, or the alert
+      if (channelFailure) return std::nullopt;
+      decoder.feed(channel->takeIncoming());
     }
   }
   template <class T>

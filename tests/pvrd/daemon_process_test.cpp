@@ -208,26 +208,56 @@ TEST_CASE("a malformed client frame gets an Error with the decoder's code and a 
   CHECK_FALSE(c.next(5));
 }
 
-TEST_CASE("a wrong token is refused and the right one accepted") {
+TEST_CASE("a wrong token fails the secure channel, the right one opens it, and nothing passes in the clear") {
   const fs::path dir = makeDataDir("token");
   const fs::path tokenFile = dir.parent_path() / ("token_" + std::to_string(::getpid()));
   std::ofstream(tokenFile) << "s3cret\n";
-  Daemon d(dir, {"--token-file", tokenFile.string()});
+  fs::permissions(tokenFile, fs::perms::owner_read | fs::perms::owner_write);
+  Daemon d(dir, {"--token-file", tokenFile.string()}, {}, logPath("token"));
   for (const std::string token : {"wrong", "s3cret"}) {
     Client c(d.port);
     c.send(proto::Hello{"daemon test"});
     CHECK(c.expect<proto::Welcome>().authRequired);
-    const auto challenge = c.expect<proto::AuthChallenge>();
-    c.send(proto::AuthResponse{pvr::daemon::hmacSha256(token, challenge.nonce)});
+    c.secure(token);
+    c.send(proto::CatalogRequest{});
     if (token == "wrong") {
-      CHECK(c.expectError(5).code == proto::ErrorCode::kAuthFailed);
-      CHECK(c.expect<proto::Close>(5).reason.size() > 0);
+      CHECK_FALSE(c.next(5));
+      REQUIRE(c.channelFailure);
+      CHECK(c.channelFailure->code == proto::ErrorCode::kAuthFailed);
     } else {
-      c.expect<proto::Ok>();
-      c.send(proto::CatalogRequest{});
       CHECK(c.expect<proto::CatalogReply>().datasets.size() == 1);
+      CHECK(c.channel->established());
     }
   }
+  // A plain frame where the channel should start ends the connection.
+  Client plain(d.port);
+  plain.send(proto::Hello{"daemon test"});
+  CHECK(plain.expect<proto::Welcome>().authRequired);
+  plain.send(proto::CatalogRequest{});
+  CHECK_FALSE(plain.next(5));
+  const std::string log = d.log();
+  CHECK(log.find("refused the client: secure channel: the handshake failed") != std::string::npos);
+  CHECK(log.find("authenticated (secure channel)") != std::string::npos);
+}
+
+TEST_CASE("a token file other users may read is refused, saying how to fix it") {
+  const fs::path dir = makeDataDir("tokenmode");
+  const fs::path tokenFile = dir.parent_path() / ("token_open_" + std::to_string(::getpid()));
+  std::ofstream(tokenFile) << "s3cret\n";
+  fs::permissions(tokenFile, fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read |
+                                 fs::perms::others_read);
+  // pvrd refuses to start: its exit status and what it printed.
+  const std::string command = std::string(PVRD_PATH) + " --listen 127.0.0.1:0 --data-dir " + dir.string() +
+                              " --token-file " + tokenFile.string() + " 2>&1";
+  FILE* p = ::popen(command.c_str(), "r");
+  REQUIRE(p);
+  std::string output;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, p)) output += buf;
+  const int status = ::pclose(p);
+  CHECK(WEXITSTATUS(status) == 2);
+  CHECK(output.find("token file " + tokenFile.string() + " has mode 0644: other users may read or change it; "
+                    "make it private with: chmod 600 " + tokenFile.string()) != std::string::npos);
 }
 
 TEST_CASE("extra connections over --max-sessions get too many sessions") {

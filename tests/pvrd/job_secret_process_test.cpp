@@ -12,10 +12,6 @@ using namespace pvr::daemon::testing;
 
 namespace {
 
-fs::path logPath(const std::string& tag) {
-  return fs::path(PVR_TEST_TMP) / ("pvrd_" + tag + "_" + std::to_string(::getpid()) + ".log");
-}
-
 std::vector<std::string> linesContaining(const std::string& text, const std::string& what) {
   std::vector<std::string> found;
   std::istringstream lines(text);
