@@ -144,7 +144,9 @@ void logEvent(std::uint64_t session, const std::string& event) {
   std::string line = std::string(when) + "." + std::to_string(ts.tv_nsec / 1000000 + 1000).substr(1) + "Z ";
   line += session ? "session " + std::to_string(session) : std::string("pvrd");
   line += ": ";
-  for (char c : event) line += (c == '\n' || c == '\r') ? ' ' : c;
+  // Client text (a Hello's software name, a dataset, an account) may hold
+  // terminal escapes: every byte outside printable ASCII is masked.
+  line += printable({reinterpret_cast<const std::uint8_t*>(event.data()), event.size()}, event.size());
   line += '\n';
   [[maybe_unused]] auto n = ::write(STDERR_FILENO, line.data(), line.size());
 }

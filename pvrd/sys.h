@@ -35,7 +35,9 @@ std::string errnoText(const char* call);
 // Seconds on the monotonic clock.
 double monotonicSeconds();
 
-// One log record on stderr: "<ISO time> session <id>: <event>" (id 0: the daemon).
+// One log record on stderr: "<ISO time> session <id>: <event>" (id 0: the
+// daemon), every byte of the event outside printable ASCII masked as \xNN
+// (client text may hold terminal escapes or line breaks).
 void logEvent(std::uint64_t session, const std::string& event);
 
 // `bytes` with non-printable characters masked, at most `max` of them.

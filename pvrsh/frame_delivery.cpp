@@ -22,18 +22,9 @@ void Session::handleFrame(Sequence& seq, const proto::ImageFrame& f, bool final)
 
   // Sinks: the photo, then files, then the callback (which may look at both).
   if (!photo_.empty()) putPhoto(interp_, photo_, pixels);
-  const auto numbered = [&](const std::string& pattern) {
-    char buf[4096];
-    std::snprintf(buf, sizeof buf, pattern.c_str(), static_cast<unsigned long long>(number));
-    return std::string(buf);
-  };
-  if (!dir_.empty()) {
-    std::string base = name_;
-    if (!base.empty() && base[0] == ':') base.erase(0, 1);
-    writePng(pixels, numbered(dir_ + "/" + base + "_%05llu.png"));
-  }
-  if (!filePattern_.empty()) {
-    writePng(pixels, numbered(filePattern_));
+  if (!dir_.empty()) writePng(pixels, numberedInDirectory(dir_, name_).name(number));
+  if (!files_.empty()) {
+    writePng(pixels, files_.name(number));
     if (seq.frames.size() == 1) firstFileNumber_ = number;
   }
   if (progressOn(interp_)) printProgress(seq);
@@ -74,9 +65,7 @@ void Session::assembleAnimation(const Sequence& seq) {
   // The frames were written as numbered PNGs beside the target; ffmpeg,
   // where installed, turns this sequence's into the file.
   if (animatedTarget_.empty() || seq.frames.empty()) return;
-  std::string input = filePattern_;
-  const auto at = input.find("%05llu");
-  if (at != std::string::npos) input.replace(at, 6, "%05d");
+  const std::string input = files_.pattern();
   Tcl_InterpState saved = Tcl_SaveInterpState(interp_, TCL_OK);
   const bool found = Tcl_Eval(interp_, "auto_execok ffmpeg") == TCL_OK && *Tcl_GetStringResult(interp_) != '\0';
   if (!found) {
@@ -85,10 +74,15 @@ void Session::assembleAnimation(const Sequence& seq) {
   } else {
     Tcl_Obj* cmd = Tcl_NewListObj(0, nullptr);
     Tcl_IncrRefCount(cmd);
+    // MP4: H.264 in 4:2:0 (the one chroma layout every player takes; it
+    // needs even sides). GIF: one palette made for these frames.
+    const bool gif = animatedTarget_.size() >= 4 && animatedTarget_.compare(animatedTarget_.size() - 4, 4, ".gif") == 0;
+    const std::string filter = gif ? "split[a][b];[a]palettegen=stats_mode=full[p];[b][p]paletteuse=dither=sierra2_4a"
+                                   : "scale=trunc(iw/2)*2:trunc(ih/2)*2,format=yuv420p";
     for (const std::string& a : {std::string("exec"), std::string("ffmpeg"), std::string("-y"), std::string("-loglevel"),
                                  std::string("error"), std::string("-framerate"), std::string("10"),
                                  std::string("-start_number"), std::to_string(firstFileNumber_), std::string("-i"), input,
-                                 animatedTarget_, std::string("2>@1")})
+                                 std::string("-vf"), filter, animatedTarget_, std::string("2>@1")})
       Tcl_ListObjAppendElement(nullptr, cmd, Tcl_NewStringObj(a.c_str(), -1));
     if (Tcl_EvalObjEx(interp_, cmd, TCL_EVAL_GLOBAL) != TCL_OK)
       std::fprintf(stderr, "%s: ffmpeg could not write %s: %s\n", name_.c_str(), animatedTarget_.c_str(),

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "connection.h"
+#include "numbered_file.h"
 #include "frame_image.h"
 #include "scene_options.h"
 #include "tcl_util.h"
@@ -127,7 +128,7 @@ class Session : public Connection::Listener {
   std::string photo_;
   Tcl_Obj* callback_ = nullptr;  // command prefix; frame and timing appended
   Tcl_Obj* notify_ = nullptr;    // command prefix; event and details appended
-  std::string filePattern_;     // printf pattern of one %05llu: the numbered PNGs
+  NumberedFile files_;          // `image file`: the numbered PNGs; empty: none
   std::string animatedTarget_;  // .gif or .mp4 that ffmpeg assembles; empty: none
   std::string dir_;
 

@@ -103,7 +103,7 @@ void Session::finishSequence(std::uint32_t id) {
   sequences_.erase(it);
   last_ = seq;
   if (progressOn(interp_) && !seq.frames.empty()) printTable(seq);
-  if (!filePattern_.empty() && !seq.cancelled) assembleAnimation(seq);
+  if (!files_.empty() && !seq.cancelled) assembleAnimation(seq);
   notify(seq.cancelled ? "cancelled" : "done", {Tcl_NewWideIntObj(Tcl_WideInt(seq.frames.size()))});
 }
 

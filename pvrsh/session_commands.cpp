@@ -83,32 +83,6 @@ int closeCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   return TCL_OK;
 }
 
-// A pattern for numbered PNG files from `image file F`: F with one %d
-// (optionally %0Nd) numbers the frames; otherwise _00000 goes before the
-// extension. F ending in .gif or .mp4 names an animated file: the PNGs go
-// beside it and ffmpeg assembles them after each sequence.
-void filePattern(const std::string& file, std::string& pattern, std::string& animated) {
-  animated.clear();
-  const auto dot = file.rfind('.');
-  const std::string ext = dot == std::string::npos ? "" : file.substr(dot);
-  const std::string stem = dot == std::string::npos ? file : file.substr(0, dot);
-  if (ext == ".gif" || ext == ".mp4") {
-    animated = file;
-    pattern = stem + "_%05llu.png";
-    return;
-  }
-  const auto pct = file.find('%');
-  if (pct == std::string::npos) {
-    pattern = stem + "_%05llu" + (ext == ".png" ? ext : ext + ".png");
-    return;
-  }
-  std::size_t end = pct + 1;
-  while (end < file.size() && std::isdigit(static_cast<unsigned char>(file[end]))) ++end;
-  if (end >= file.size() || file[end] != 'd' || file.find('%', end) != std::string::npos)
-    argsError("FILE", "image file: a pattern takes one %d or %0Nd, got '" + file + "'");
-  pattern = file.substr(0, end) + "llu" + file.substr(end + 1);
-}
-
 // :s image window|callback|file|dir ?VALUE?  (no value: the current one)
 int imageCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   static const char* const kKinds[] = {"callback", "dir", "file", "window", nullptr};
@@ -120,7 +94,8 @@ int imageCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   if (Tcl_GetIndexFromObj(interp, objv[2], kKinds, "image target", 0, &kind) != TCL_OK)
     throw TclError({"PVR", "ARGS", "IMAGE"}, Tcl_GetStringResult(interp));
   if (objc == 3) {
-    const std::string values[] = {"", s.dir_, s.animatedTarget_.empty() ? s.filePattern_ : s.animatedTarget_, s.photo_};
+    const std::string values[] = {"", s.dir_, s.animatedTarget_.empty() ? s.files_.pattern() : s.animatedTarget_,
+                                  s.photo_};
     Tcl_SetObjResult(interp, kind == 0 ? (s.callback_ ? s.callback_ : Tcl_NewObj()) : Tcl_NewStringObj(values[kind].c_str(), -1));
     return TCL_OK;
   }
@@ -136,6 +111,7 @@ int imageCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
       break;
     case 1:
       if (!v.empty()) {
+        numberedInDirectory(v, s.name_);  // refuses names the file system would cut
         Tcl_Obj* path = objv[3];
         if (Tcl_FSCreateDirectory(path) != TCL_OK && Tcl_FSAccess(path, 2) != 0)
           throw TclError({"PVR", "IO"}, "image dir: cannot create or write " + v);
@@ -144,10 +120,10 @@ int imageCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
       break;
     case 2:
       if (v.empty()) {
-        s.filePattern_.clear();
+        s.files_ = {};
         s.animatedTarget_.clear();
       } else {
-        filePattern(v, s.filePattern_, s.animatedTarget_);
+        s.files_ = numberedFileOf(v, s.animatedTarget_);
       }
       break;
     case 3:

@@ -54,7 +54,7 @@ Tcl_Obj* Session::statusObj() {
   put("scene", str(settings_.scene.dump()));
   put("window", str(photo_));
   put("callback", callback_ ? callback_ : Tcl_NewObj());
-  put("file", str(filePattern_));
+  put("file", str(files_.pattern()));
   put("dir", str(dir_));
   put("frames_received", Tcl_NewWideIntObj(Tcl_WideInt(framesReceived_)));
   put("busy", Tcl_NewBooleanObj(!sequences_.empty()));

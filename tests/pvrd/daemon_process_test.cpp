@@ -240,6 +240,19 @@ TEST_CASE("a wrong token fails the secure channel, the right one opens it, and n
   CHECK(log.find("authenticated (secure channel)") != std::string::npos);
 }
 
+TEST_CASE("escape sequences a client sends reach the log masked, never raw") {
+  Daemon d(makeDataDir("escapes"), {}, {}, logPath("escapes"));
+  Client c(d.port);
+  c.send(proto::Hello{"\x1b]0;pwned\x07\x1b[2J\nfake log line"});
+  c.expect<proto::Welcome>();
+  c.send(proto::Close{"done"});
+  c.expect<proto::Close>();
+  const std::string log = d.log();
+  CHECK(log.find("hello from '\\x1b]0;pwned\\x07\\x1b[2J\\x0afake log line'") != std::string::npos);
+  CHECK(log.find('\x1b') == std::string::npos);
+  CHECK(log.find('\x07') == std::string::npos);
+}
+
 TEST_CASE("a token file other users may read is refused, saying how to fix it") {
   const fs::path dir = makeDataDir("tokenmode");
   const fs::path tokenFile = dir.parent_path() / ("token_open_" + std::to_string(::getpid()));
