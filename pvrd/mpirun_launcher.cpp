@@ -63,13 +63,16 @@ std::string lostHostFromMpirunOutput(const std::string& text) {
   // Open MPI 4.1 names the host whose daemon it lost ("Remote daemon:
   // [[...],2] on node h2") or whose peer went away ("Peer host: h2"), or,
   // when a rank finds the lost host's ranks unreachable first, its address
-  // ("connect() to 10.213.7.12:1024 failed").
+  // ("connect() to 10.213.7.12:1024 failed"), or, when the ssh that runs
+  // the host's daemon notices first, ssh's own words ("Connection to
+  // 10.213.7.12 closed by remote host.", then a generic ORTE block).
   static const std::regex daemon(R"(Remote daemon:[^\n]*on node\s+([^\s]+))");
   static const std::regex peer(R"(Peer host:\s*([^\s]+))");
   static const std::regex unreachable(R"(connect\(\) to \[?([0-9A-Fa-f.:]+?)\]?:[0-9]+ failed)");
+  static const std::regex sshClosed(R"(Connection to ([^\s]+) closed by remote host)");
   std::smatch m;
   if (std::regex_search(text, m, daemon) || std::regex_search(text, m, peer)) return m[1].str();
-  if (std::regex_search(text, m, unreachable)) return hostNameOf(m[1].str());
+  if (std::regex_search(text, m, unreachable) || std::regex_search(text, m, sshClosed)) return hostNameOf(m[1].str());
   return {};
 }
 

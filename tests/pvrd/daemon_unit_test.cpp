@@ -231,6 +231,12 @@ TEST_CASE("a host Open MPI lost contact with is named in the job's end text") {
   // 127.0.0.1), and an address nobody names stays an address.
   CHECK(lostHostFromMpirunOutput("  Local host: h3\n  Message:    connect() to 127.0.0.1:1024 failed\n") == "localhost");
   CHECK(lostHostFromMpirunOutput("  Message:    connect() to 192.0.2.77:1024 failed\n") == "192.0.2.77");
+  // ssh noticing first: its line, then ORTE's generic block (one run in
+  // five of tests/cluster/host_lost.sh).
+  CHECK(lostHostFromMpirunOutput("Connection to 192.0.2.78 closed by remote host.\n"
+                                 "--------------------------------------------------------------------------\n"
+                                 "ORTE was unable to reliably start one or more daemons.\n") == "192.0.2.78");
+  CHECK(lostHostFromMpirunOutput("Connection to 127.0.0.1 closed by remote host.\n") == "localhost");
   CHECK(lostHostFromMpirunOutput("mpirun noticed that process rank 1 with PID 4242 on node x exited") == "");
   const std::string text = mpirunEndText("mpirun exited with status 1", lostDaemon);
   CHECK_THAT(text, Catch::StartsWith("host h2 was lost"));
