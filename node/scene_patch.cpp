@@ -66,6 +66,7 @@ std::variant<SessionScene, ProtocolError> patchScene(const SessionScene& current
                                                      const std::string& dataDir) {
   SessionScene next = current;
   if (!request.sceneJson.empty()) {
+    if (auto deep = proto::checkJsonDepth(request.sceneJson, "scene")) return *deep;
     nlohmann::json patch = nlohmann::json::parse(request.sceneJson, nullptr, false);
     if (patch.is_discarded() || !patch.is_object())
       return ProtocolError{ErrorCode::kBadArgument, "scene: not a JSON object"};

@@ -124,7 +124,7 @@ struct Welcome {
   static constexpr WireInfo kWire{0x02, "Welcome", &Limits::maxControlPayload};
   std::string software;       // "pvrd 0.1"
   std::uint32_t maxRanks = 0; // the most ranks a session may ask for
-  bool authRequired = false;  // an AuthChallenge follows
+  bool authRequired = false;  // the secure channel keyed by the token follows
   static auto fields(auto& self) { return std::tie(self.software, self.maxRanks, self.authRequired); }
   bool operator==(const Welcome&) const = default;
 };

@@ -9,6 +9,7 @@
 #include "frame_relay.h"
 #include "frame_header.h"
 #include "image_limits.h"
+#include "json_depth.h"
 #include "message_table.h"
 #include "pixel_codec.h"
 #include "protocol_error.h"

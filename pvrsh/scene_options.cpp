@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <iterator>
 #include <optional>
 
 #include "tcl_util.h"
@@ -138,7 +139,10 @@ void setTransferPoints(Apply& a) {
 void setTransferPreset(Apply& a) {
   std::ifstream in(a.value);
   if (!in) argsError("TFPRESET", "-tfpreset: cannot read " + a.value);
-  json preset = json::parse(in, nullptr, false);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // It goes to the server, which refuses deeper JSON: say so here.
+  if (auto deep = proto::checkJsonDepth(text, "-tfpreset " + a.value)) argsError("TFPRESET", deep->text);
+  json preset = json::parse(text, nullptr, false);
   if (preset.is_discarded()) argsError("TFPRESET", "-tfpreset: " + a.value + " is not JSON");
   if (!preset.is_array()) preset = json::array({std::move(preset)});
   a.scene(transferSource("paraview", std::move(preset)));

@@ -316,6 +316,8 @@ int performanceCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv
   const auto replies = s.query(proto::PerformanceRequest{proto::PerformanceQuery(query), cluster}, 120);
   for (const auto& m : replies)
     if (const auto* r = std::get_if<proto::PerformanceReply>(&m)) {
+      if (auto deep = proto::checkJsonDepth(r->json, "performance reply"))
+        throw TclError({"PVR", "PROTOCOL", "MALFORMED_PAYLOAD"}, deep->text);
       nlohmann::json doc;
       try {
         doc = nlohmann::json::parse(r->json);

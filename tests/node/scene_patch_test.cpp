@@ -138,3 +138,11 @@ TEST_CASE("a paraview_preset names a file of the data directory's presets folder
                                   R"("transfer_function": {"paraview_preset": "/etc/shadow"}}]})"});
   CHECK_THAT(e.text, Catch::StartsWith("scene.volumes[0].transfer_function.paraview_preset: no preset '/etc/shadow'"));
 }
+
+TEST_CASE("a scene patch nested deeper than the protocol's JSON limit is refused before it is parsed") {
+  std::string bomb;
+  for (int i = 0; i < 100000; ++i) bomb += "{\"a\":";
+  const auto e = refused({}, {"", bomb});
+  CHECK(e.code == proto::ErrorCode::kMalformedPayload);
+  CHECK(e.text == "scene: JSON nests deeper than 64 levels (at byte 320)");
+}
