@@ -28,6 +28,9 @@ void onStop(int) { gStop = 1; }
 // The master rank must connect back this soon after its ranks have hosts
 // (after the launch for mpirun, after the grant for a batch allocation).
 constexpr double kMasterConnectSeconds = 60;
+// The most bytes a client may send before its Hello is complete: one
+// control frame (Hello) and its header.
+constexpr std::size_t kMaxBeforeHello = proto::kHeaderBytes + proto::Limits{}.maxControlPayload;
 // How long a job's end waits for the launcher to exit and say why.
 constexpr double kLauncherEndSeconds = 5;
 
@@ -446,6 +449,14 @@ int Session::run() {
       if (const auto& e = fromClient_.error()) {
         log("bad frame from client, first bytes '" + printable(std::span(buf.data(), std::size_t(got))) + "'");
         endConnection(e->code, e->text, 0);
+        break;
+      }
+      // Before Hello only a Hello may come, and a Hello is a control frame:
+      // buffering more for a stranger (up to the 64 MiB an image frame may
+      // have) is what a flood of connections would use to exhaust memory.
+      if (!greeted_ && fromClient_.bufferedBytes() > kMaxBeforeHello) {
+        endConnection(ErrorCode::kLimitExceeded,
+                      "more than " + std::to_string(kMaxBeforeHello) + " bytes before Hello", 0);
         break;
       }
       if (fromClient_.bufferedBytes() == 0) frameStarted = 0;

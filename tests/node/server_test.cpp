@@ -727,6 +727,35 @@ TEST_CASE_METHOD(Fixture, "scene patches are checked whole before and after the 
   CHECK(job.close());
 }
 
+TEST_CASE_METHOD(Fixture, "requests flooding in during a sequence are kept up to a bound and the rest refused, each answered") {
+  Job job(2, {});
+  job.send(proto::SessionOpen{2, {}, ""});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  const auto rotation = job.send(proto::RenderRotation{{0, 1, 0}, 0, 199, 200});
+  constexpr int kFlood = 100;
+  for (int i = 0; i < kFlood; ++i) job.send(proto::RenderFrame{});
+  int frames = 0, refused = 0, rendered = 0;
+  while (frames < 200 || rendered + refused < kFlood) {
+    auto d = job.receive();
+    REQUIRE(d);
+    if (const auto* e = std::get_if<proto::ErrorMessage>(&d->message)) {
+      CHECK(e->code == proto::ErrorCode::kLimitExceeded);
+      CHECK_THAT(e->text, Catch::Contains("requests wait for the sequence in progress"));
+      ++refused;
+    } else if (std::holds_alternative<proto::ImageFrame>(d->message)) {
+      if (d->info.requestId == rotation) ++frames;
+      else ++rendered;
+    }
+  }
+  // Kept ones render after the rotation; none is lost without an answer.
+  CHECK(rendered >= 64);
+  CHECK(refused > 0);
+  CHECK(rendered + refused == kFlood);
+  CHECK(job.close());
+}
+
 TEST_CASE_METHOD(Fixture, "without PVR_JOB_SECRET the master does not connect back, and the job ends") {
   // No secret, no key for the secure channel: nothing to connect with.
   Job job(2, {}, {.secret = std::nullopt});

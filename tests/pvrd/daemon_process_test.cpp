@@ -240,6 +240,24 @@ TEST_CASE("a wrong token fails the secure channel, the right one opens it, and n
   CHECK(log.find("authenticated (secure channel)") != std::string::npos);
 }
 
+TEST_CASE("a stranger announcing a huge first frame is cut off after one control frame's worth of bytes") {
+  Daemon d(makeDataDir("prehello"));
+  Client c(d.port);
+  std::vector<std::uint8_t> header(proto::kHeaderBytes);
+  proto::writeHeader({proto::kProtocolVersion, proto::ImageFrame::kWire.type, 0, 1, 60u << 20},
+                     std::span(header).first<proto::kHeaderBytes>());
+  c.writeRaw(header);
+  const std::vector<std::uint8_t> filler(200 << 10, 0);
+  ::send(c.fd, filler.data(), filler.size(), MSG_NOSIGNAL);
+  const auto e = c.expectError(5);
+  CHECK(e.code == proto::ErrorCode::kLimitExceeded);
+  CHECK(e.text == "more than " + std::to_string(proto::kHeaderBytes + proto::Limits{}.maxControlPayload) +
+                      " bytes before Hello");
+  // pvrd serves the next client.
+  Client next(d.port);
+  next.hello();
+}
+
 TEST_CASE("escape sequences a client sends reach the log masked, never raw") {
   Daemon d(makeDataDir("escapes"), {}, {}, logPath("escapes"));
   Client c(d.port);
