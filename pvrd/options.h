@@ -36,7 +36,9 @@ inline constexpr const char* kUsage =
 // Parses argv[1..]; on a bad command line returns nullopt and sets `error`.
 std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, std::string& error);
 
-// True for 127.0.0.0/8, ::1 and "localhost".
+// True when `host` resolves, and only to loopback addresses (127.0.0.0/8,
+// ::1): "localhost", "127.0.0.2", "::1"; not "127.attacker" (unless a
+// resolver says it is loopback), not 0.0.0.0, not a name that fails.
 bool isLoopback(const std::string& host);
 
 }  // namespace pvr::daemon

@@ -168,6 +168,23 @@ TEST_CASE("options parse listen address, limits and refuse a public bind without
   CHECK_FALSE(parseOptions({"--data-dir", "/d", "--bogus", "1"}, error));
 }
 
+TEST_CASE("loopback is decided on the addresses a listen name resolves to, not on its spelling") {
+  for (const char* host : {"127.0.0.1", "127.0.0.2", "127.1", "::1", "localhost"}) {
+    INFO(host);
+    CHECK(isLoopback(host));
+  }
+  // A name that only starts like loopback, the wildcard, a public address,
+  // a v4-mapped public address, nothing.
+  for (const char* host : {"127.attacker", "127.0.0.1.example.invalid", "0.0.0.0", "::", "192.0.2.1",
+                           "::ffff:192.0.2.1", ""}) {
+    INFO(host);
+    CHECK_FALSE(isLoopback(host));
+  }
+  std::string error;
+  CHECK_FALSE(parseOptions({"--listen", "127.attacker:7000", "--data-dir", "/d"}, error));
+  CHECK(error == "refusing to listen on 127.attacker without --token-file (see docs/pvrd.md)");
+}
+
 TEST_CASE("options: --advertise takes numeric IPv4, --launcher a known name, slurm's options need slurm") {
   std::string error;
   auto o = parseOptions({"--data-dir", "/d", "--advertise", "10.213.7.10", "--launcher", "slurm", "--partition", "vis",
