@@ -6,6 +6,14 @@
 #include "session.h"
 
 namespace pvr::tcl {
+
+namespace {
+
+// Non-final replies one request may have (a SessionOpen waiting in a batch
+// queue gets one per change of state; nothing else gets more than a few).
+constexpr std::size_t kMaxRepliesPerRequest = 1000;
+
+}  // namespace
 namespace {
 
 TclError remoteError(const proto::ErrorMessage& e) {
@@ -53,6 +61,15 @@ void Session::onMessage(const proto::Decoded& d) {
         if (const auto* r = std::get_if<proto::SessionReady>(&d.message)) {
           ranks_ = r->rankCount;
           layout_ = r->clusters;
+        }
+        if (pending.replies.size() >= kMaxRepliesPerRequest) {
+          // A server that never ends a request would grow this without
+          // bound (3.1 GiB in 7 s): the session ends instead.
+          onFailure(TclError({"PVR", "PROTOCOL", "LIMIT_EXCEEDED"},
+                             peer_ + " sent more than " + std::to_string(kMaxRepliesPerRequest) +
+                                 " replies to one request without ending it; the session is closed"));
+          conn_.reset();
+          return;
         }
         pending.replies.push_back(d.message);
         pending.done = d.info.final();
