@@ -59,10 +59,13 @@ NumberedFile numberedFileOf(const std::string& file, std::string& animated) {
     animated = file;
     return checked({stem + "_", 5, ".png"}, file);
   }
+  // Frames are PNG: another extension would be written as NAME.avi.png.
+  if (!ext.empty() && ext != ".png")
+    refuse("image file: cannot write " + ext + " files; frames are .png, animations .gif or .mp4 (got '" + file + "')");
   // Only the file name may number: a directory's '%' is just a character.
   const std::size_t leaf = slash == std::string::npos ? 0 : slash + 1;
   const auto pct = file.find('%', leaf);
-  if (pct == std::string::npos) return checked({stem + "_", 5, ext == ".png" ? ext : ext + ".png"}, file);
+  if (pct == std::string::npos) return checked({stem + "_", 5, ".png"}, file);
   std::size_t end = pct + 1;
   while (end < file.size() && file[end] >= '0' && file[end] <= '9') ++end;
   if (end >= file.size() || file[end] != 'd' || file.find('%', end) != std::string::npos)

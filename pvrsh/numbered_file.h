@@ -25,12 +25,14 @@ struct NumberedFile {
 };
 
 // The files of `image file FILE`: FILE whose file name has one %d or %0Nd
-// (N up to 20) numbers the frames (a '%' in its directory is a character); otherwise _00000 goes before the extension (".png"
-// added when FILE has another one). FILE ending in .gif or .mp4 names an
-// animated file, returned in `animated`: the PNGs go beside it. Throws
-// TclError {PVR ARGS FILE} for a second '%' or a bad width, and when the
-// longest name (20 digits) would exceed what the file system takes (a
-// component over NAME_MAX or a path over PATH_MAX), rather than truncate.
+// (N up to 20) numbers the frames (a '%' in its directory is a
+// character); otherwise _00000 goes before the extension (".png" added
+// when FILE has none). FILE ending in .gif or .mp4 names an animated file,
+// returned in `animated`: the PNGs go beside it. Throws TclError
+// {PVR ARGS FILE} for another extension (frames are PNG), a second '%' or
+// a bad width, and when the longest name (20 digits) would exceed what the
+// file system takes (a component over NAME_MAX or a path over PATH_MAX),
+// rather than truncate.
 NumberedFile numberedFileOf(const std::string& file, std::string& animated);
 
 // The files of `image dir DIR` for the session NAME: DIR/NAME_00000.png,
