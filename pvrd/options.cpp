@@ -102,13 +102,13 @@ std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, 
       o.scancel = v;
     } else if (a == "--node") {
       o.node = v;
-    } else if (a == "--idle-timeout") {
+    } else if (a == "--idle-timeout" || a == "--frame-timeout") {
       int s = 0;
       if (!toInt(v, 1, 1 << 30, s)) {
-        error = "--idle-timeout takes a positive number of seconds, not '" + v + "'";
+        error = a + " takes a positive number of seconds, not '" + v + "'";
         return std::nullopt;
       }
-      o.idleTimeout = s;
+      (a == "--idle-timeout" ? o.idleTimeout : o.frameTimeout) = s;
     } else {
       error = "unknown option '" + a + "'";
       return std::nullopt;

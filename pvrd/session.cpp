@@ -91,6 +91,9 @@ class Session {
   // Requests answered with an Error after pvrd refused a master frame: the
   // master's further frames for them are dropped until its FINAL one.
   std::set<std::uint32_t> refusedRequests_;
+  // Render requests sent to the master whose FINAL frame has not come back:
+  // while one is in flight the client waits for us, it is not idle.
+  std::set<std::uint32_t> rendering_;
   bool greeted_ = false, authenticated_ = false, done_ = false;
   std::deque<std::vector<std::uint8_t>> pendingToMaster_;
   double launchedAt_ = 0;
@@ -225,6 +228,9 @@ void Session::onClient(proto::Decoded frame) {
     }
     return forward(proto::SetScene{std::get<std::string>(resolved), scene->sceneJson}, id);
   }
+  if (std::holds_alternative<proto::RenderFrame>(m) || std::holds_alternative<proto::RenderRotation>(m) ||
+      std::holds_alternative<proto::RenderTimeSteps>(m))
+    rendering_.insert(id);
   forward(m, id);
 }
 
@@ -258,6 +264,7 @@ void Session::onMaster(proto::RelayItem item) {
   const std::uint32_t id = frame.header.requestId;
   const bool final = (frame.header.flags & proto::kFlagFinal) != 0;
   if (final && id == openRequest_) openRequest_ = 0;
+  if (final) rendering_.erase(id);
   if (refusedRequests_.count(id)) {
     // The client already has its Error for this request.
     if (final) refusedRequests_.erase(id);
@@ -279,6 +286,7 @@ void Session::refuseMasterFrame(const proto::RefusedFrame& refused) {
   const std::uint32_t id = refused.header.requestId;
   const bool final = (refused.header.flags & proto::kFlagFinal) != 0;
   if (final && id == openRequest_) openRequest_ = 0;
+  if (final) rendering_.erase(id);
   const std::string what = "the rendering job's " + std::string(refused.info->name);
   log("refused " + what + " for request " + std::to_string(id) + ": " + refused.error.text);
   if (refusedRequests_.count(id)) {
@@ -380,6 +388,7 @@ void Session::teardown() {
   if (master_ >= 0) ::close(std::exchange(master_, -1));
   connectBack_.reset();
   queued_.reset();
+  rendering_.clear();
   openRequest_ = 0;
   masterDeadline_ = 0;
   if (!launcher_) return;
@@ -434,8 +443,10 @@ int Session::run() {
       if (!plain) break;
       const bool secure = clientChannel_ != nullptr;
       fromClient_.feed(*plain);
+      bool completed = false;
       while (auto frame = fromClient_.pop()) {
         lastFrame = now;
+        completed = true;
         onClient(std::move(*frame));
         if (done_) break;
         // Hello started the secure channel: nothing may follow it in the clear.
@@ -459,15 +470,19 @@ int Session::run() {
                       "more than " + std::to_string(kMaxBeforeHello) + " bytes before Hello", 0);
         break;
       }
+      // The timer runs from the start of the frame in progress: a frame
+      // completed in this read means the bytes left began a new one (a
+      // client streaming frames back to back never empties the buffer).
       if (fromClient_.bufferedBytes() == 0) frameStarted = 0;
-      else if (before == 0 || frameStarted == 0) frameStarted = now;
+      else if (before == 0 || frameStarted == 0 || completed) frameStarted = now;
     }
     if (frameStarted > 0 && now - frameStarted > opt_.frameTimeout) {
       endConnection(ErrorCode::kTimeout, "the rest of a started frame did not arrive in time", 0);
       break;
     }
-    // A client waiting for its allocation is not idle.
-    if (queued_) lastFrame = now;
+    // A client waiting for its allocation, or for frames it asked for, is
+    // not idle.
+    if (queued_ || !rendering_.empty()) lastFrame = now;
     if (now - lastFrame > opt_.idleTimeout) {
       endConnection(ErrorCode::kTimeout, "idle for " + std::to_string(int(opt_.idleTimeout)) + " s", 0);
       break;

@@ -258,6 +258,54 @@ TEST_CASE("a stranger announcing a huge first frame is cut off after one control
   next.hello();
 }
 
+TEST_CASE("a client waiting for its own rotation is not idle") {
+  Daemon d(makeDataDir("notidle"), {"--idle-timeout", "1"});
+  Client c(d.port);
+  c.hello();
+  c.openSession();
+  c.send(proto::SetScene{"ball/ball.json", R"({"image": {"width": 192, "height": 192}})"});
+  c.expect<proto::Ok>();
+  // Longer than the idle timeout, with nothing sent meanwhile.
+  const auto started = Clock::now();
+  c.send(proto::RenderRotation{{0, 0, 1}, 0, 299, 300});
+  int frames = 0;
+  while (frames < 300) {
+    auto m = c.next(30);
+    REQUIRE(m);
+    if (const auto* e = std::get_if<proto::ErrorMessage>(&m->message)) FAIL("Error " << e->text);
+    if (std::holds_alternative<proto::ImageFrame>(m->message)) ++frames;
+  }
+  INFO("the rotation took " << since(started) << " s");
+  CHECK(since(started) > 1.0);  // else this test does not test the idle timer
+  // Idle again afterwards: the timeout applies.
+  CHECK(c.expectError(10).code == proto::ErrorCode::kTimeout);
+}
+
+TEST_CASE("a client streaming frames back to back is timed per frame, not from its first byte") {
+  Daemon d(makeDataDir("streaming"), {"--frame-timeout", "1"});
+  Client c(d.port);
+  c.hello();
+  // Each write ends half-way into the next StatusRequest, so pvrd's buffer
+  // is never empty for 2.5 s while every frame completes within 0.25 s.
+  const auto status = proto::encode(proto::StatusRequest{}, 7, 0);
+  const std::size_t half = status.size() / 2;
+  // One write: the end of a frame and the start of the next.
+  std::vector<std::uint8_t> seam(status.begin() + std::ptrdiff_t(half), status.end());
+  seam.insert(seam.end(), status.begin(), status.begin() + std::ptrdiff_t(half));
+  c.writeRaw(std::span(status).first(half));
+  for (int i = 0; i < 10; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+    c.writeRaw(seam);
+  }
+  c.writeRaw(std::span(status).subspan(half));
+  for (int i = 0; i < 11; ++i) {
+    auto m = c.next(5);
+    REQUIRE(m);
+    if (const auto* e = std::get_if<proto::ErrorMessage>(&m->message)) FAIL("Error " << e->text);
+    CHECK(std::holds_alternative<proto::StatusReply>(m->message));
+  }
+}
+
 TEST_CASE("escape sequences a client sends reach the log masked, never raw") {
   Daemon d(makeDataDir("escapes"), {}, {}, logPath("escapes"));
   Client c(d.port);
