@@ -67,8 +67,12 @@ std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, 
       o.dataDir = v;
     } else if (a == "--hostfile") {
       o.hostfile = v;
-    } else if (a == "--max-ranks" || a == "--max-sessions") {
-      int& target = a == "--max-ranks" ? o.maxRanks : o.maxSessions;
+    } else if (a == "--max-ranks" || a == "--max-sessions" || a == "--max-unauthenticated" ||
+               a == "--max-connections") {
+      int& target = a == "--max-ranks"            ? o.maxRanks
+                    : a == "--max-sessions"       ? o.maxSessions
+                    : a == "--max-unauthenticated" ? o.maxUnauthenticated
+                                                   : o.maxConnections;
       if (!toInt(v, 1, 4096, target)) {
         error = a + " takes an integer in [1, 4096], not '" + v + "'";
         return std::nullopt;
@@ -102,13 +106,13 @@ std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, 
       o.scancel = v;
     } else if (a == "--node") {
       o.node = v;
-    } else if (a == "--idle-timeout" || a == "--frame-timeout") {
+    } else if (a == "--idle-timeout" || a == "--frame-timeout" || a == "--handshake-timeout") {
       int s = 0;
       if (!toInt(v, 1, 1 << 30, s)) {
         error = a + " takes a positive number of seconds, not '" + v + "'";
         return std::nullopt;
       }
-      (a == "--idle-timeout" ? o.idleTimeout : o.frameTimeout) = s;
+      (a == "--idle-timeout" ? o.idleTimeout : a == "--frame-timeout" ? o.frameTimeout : o.handshakeTimeout) = s;
     } else {
       error = "unknown option '" + a + "'";
       return std::nullopt;

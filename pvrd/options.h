@@ -14,7 +14,9 @@ struct DaemonOptions {
   std::string hostfile;         // passed to mpirun when set (launcher mpirun only)
   std::string advertise;        // numeric IPv4 the ranks reach the handler on; empty: advertise.h decides
   int maxRanks = 4;
-  int maxSessions = 4;
+  int maxSessions = 4;          // connections with a job (admission.h)
+  int maxUnauthenticated = 8;   // connections still in their handshake
+  int maxConnections = 64;      // handler processes in all
   std::string tokenFile;        // shared secret; required for a non-loopback address
   std::string launcher = "mpirun";  // a name of launcher.h's table
   std::string partition;        // slurm: salloc --partition; empty: the site's default
@@ -25,13 +27,15 @@ struct DaemonOptions {
   std::string node;             // pvr-node executable; empty: next to pvrd
   double idleTimeout = 600;     // seconds without a client frame
   double frameTimeout = 10;     // seconds to finish a frame once started
+  double handshakeTimeout = 10; // seconds from accept to an authenticated Hello
 };
 
 // The command line, for the usage message.
 inline constexpr const char* kUsage =
     "pvrd --listen HOST:PORT --data-dir DIR [--hostfile F] [--advertise ADDR] [--launcher mpirun|slurm] "
     "[--partition P] [--time T] [--max-ranks N] [--max-sessions N] [--token-file F] [--mpirun PATH] "
-    "[--salloc PATH] [--scancel PATH] [--node PATH] [--idle-timeout S]";
+    "[--max-unauthenticated N] [--max-connections N] [--salloc PATH] [--scancel PATH] [--node PATH] "
+    "[--idle-timeout S] [--frame-timeout S] [--handshake-timeout S]";
 
 // Parses argv[1..]; on a bad command line returns nullopt and sets `error`.
 std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, std::string& error);

@@ -1,16 +1,21 @@
 // pvrd: accepts connections and forks one session handler per client
-// (session.h). The loop polls the listening socket and a self-pipe that the
-// SIGCHLD, SIGTERM and SIGINT handlers write to.
+// (session.h). The loop polls the listening socket, a self-pipe that the
+// SIGCHLD, SIGTERM and SIGINT handlers write to, and each handler's
+// socketpair, on which it reports its stage and asks for a session slot
+// (admission.h).
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <climits>
 #include <cstdio>
 #include <map>
+#include <vector>
 
+#include "admission.h"
 #include "advertise.h"
 #include "auth.h"
 #include "token_file.h"
@@ -46,6 +51,38 @@ void refuse(int fd, pvr::proto::ErrorCode code, const std::string& text) {
   writeAll(fd, pvr::proto::encode(pvr::proto::ErrorMessage{code, text}, 0, pvr::proto::kFlagFinal), error);
   writeAll(fd, pvr::proto::encode(pvr::proto::Close{text}, 0, pvr::proto::kFlagFinal), error);
   ::close(fd);
+}
+
+// A running handler: its session number and the daemon's end of its link.
+struct Handler {
+  std::uint64_t id = 0;
+  int link = -1;
+};
+
+// One event from a handler's link; a slot request is answered at once.
+void serveHandlerLink(pid_t pid, Handler& handler, Admission& admission) {
+  char events[16];
+  const ssize_t n = ::recv(handler.link, events, sizeof events, MSG_DONTWAIT);
+  if (n == 0) {
+    // The handler exited (its SIGCHLD reaps it): it holds nothing now.
+    admission.remove(pid);
+    ::close(std::exchange(handler.link, -1));
+    return;
+  }
+  for (ssize_t i = 0; i < n; ++i) {
+    switch (events[i]) {
+      case admission_wire::kAuthenticated: admission.authenticated(pid); break;
+      case admission_wire::kReleaseSlot: admission.releaseSlot(pid); break;
+      case admission_wire::kRequestSlot: {
+        const auto refused = admission.requestSlot(pid);
+        if (refused) logEvent(handler.id, "no session slot: " + *refused);
+        const char answer = refused ? admission_wire::kRefused : admission_wire::kGranted;
+        [[maybe_unused]] auto sent = ::send(handler.link, &answer, 1, MSG_NOSIGNAL);
+        break;
+      }
+      default: logEvent(handler.id, "handler link: unknown event, ignored");
+    }
+  }
 }
 
 }  // namespace
@@ -98,15 +135,28 @@ int main(int argc, char** argv) {
   if (options->launcher != "mpirun" && options->advertise.empty() && isLoopback(config.advertise))
     logEvent(0, "warning: ranks on other hosts cannot reach " + config.advertise + "; give --advertise ADDR");
 
-  std::map<pid_t, std::uint64_t> handlers;
+  std::map<pid_t, Handler> handlers;
+  Admission admission({options->maxUnauthenticated, options->maxConnections, options->maxSessions});
   std::uint64_t nextSession = 1;
   bool stopping = false;
+  std::vector<pollfd> fds;
+  std::vector<pid_t> polledHandlers;
   while (!stopping) {
-    pollfd fds[2] = {{listenFd, POLLIN, 0}, {gSignalPipe[0], POLLIN, 0}};
-    if (::poll(fds, 2, -1) < 0 && errno != EINTR) {
+    fds = {{listenFd, POLLIN, 0}, {gSignalPipe[0], POLLIN, 0}};
+    polledHandlers.clear();
+    for (const auto& [pid, handler] : handlers)
+      if (handler.link >= 0) {
+        fds.push_back({handler.link, POLLIN, 0});
+        polledHandlers.push_back(pid);
+      }
+    if (::poll(fds.data(), nfds_t(fds.size()), -1) < 0 && errno != EINTR) {
       logEvent(0, errnoText("poll"));
       break;
     }
+    for (std::size_t i = 0; i < polledHandlers.size(); ++i)
+      if (fds[2 + i].revents & (POLLIN | POLLHUP | POLLERR))
+        if (auto it = handlers.find(polledHandlers[i]); it != handlers.end() && it->second.link >= 0)
+          serveHandlerLink(it->first, it->second, admission);
     if (fds[1].revents & POLLIN) {
       char sigs[64];
       ssize_t n;
@@ -117,9 +167,11 @@ int main(int argc, char** argv) {
       pid_t pid;
       while ((pid = ::waitpid(-1, &status, WNOHANG)) > 0) {
         if (auto it = handlers.find(pid); it != handlers.end()) {
-          logEvent(it->second, "handler " + std::to_string(pid) + " exited");
+          logEvent(it->second.id, "handler " + std::to_string(pid) + " exited");
+          if (it->second.link >= 0) ::close(it->second.link);
           handlers.erase(it);
         }
+        admission.remove(pid);
       }
     }
     if (stopping || !(fds[0].revents & POLLIN)) continue;
@@ -129,29 +181,42 @@ int main(int argc, char** argv) {
       continue;
     }
     const std::uint64_t id = nextSession++;
-    if (handlers.size() >= std::size_t(options->maxSessions)) {
-      logEvent(id, "refused: too many sessions (" + std::to_string(handlers.size()) + ")");
-      refuse(client, pvr::proto::ErrorCode::kLimitExceeded, "too many sessions");
+    if (const auto refused = admission.refusalAtAccept()) {
+      logEvent(id, "refused: " + *refused);
+      refuse(client, pvr::proto::ErrorCode::kLimitExceeded, *refused);
+      continue;
+    }
+    int link[2];
+    if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, link) != 0) {
+      logEvent(id, errnoText("socketpair"));
+      refuse(client, pvr::proto::ErrorCode::kInternal, "cannot start a session handler");
       continue;
     }
     const pid_t pid = ::fork();
     if (pid < 0) {
       logEvent(id, errnoText("fork"));
+      ::close(link[0]);
+      ::close(link[1]);
       refuse(client, pvr::proto::ErrorCode::kInternal, "cannot fork a session handler");
       continue;
     }
     if (pid == 0) {
       config.id = id;
-      config.inherited = {listenFd, gSignalPipe[0], gSignalPipe[1]};
+      config.admission = link[1];
+      config.inherited = {listenFd, gSignalPipe[0], gSignalPipe[1], link[0]};
+      for (const auto& [other, handler] : handlers)
+        if (handler.link >= 0) config.inherited.push_back(handler.link);
       ::_exit(runSession(config, client));
     }
     ::close(client);
-    handlers[pid] = id;
+    ::close(link[1]);
+    handlers[pid] = {id, link[0]};
+    admission.add(pid);
     logEvent(id, "accepted; handler pid " + std::to_string(pid));
   }
   logEvent(0, "stopping: ending " + std::to_string(handlers.size()) + " session(s)");
   ::close(listenFd);
-  for (auto& [pid, id] : handlers) ::kill(pid, SIGTERM);
+  for (auto& [pid, handler] : handlers) ::kill(pid, SIGTERM);
   const double t0 = monotonicSeconds();
   while (!handlers.empty()) {
     int status = 0;
@@ -162,7 +227,7 @@ int main(int argc, char** argv) {
     }
     if (pid < 0 && errno == ECHILD) break;
     if (monotonicSeconds() - t0 > 5) {
-      for (auto& [p, id] : handlers) ::kill(p, SIGKILL);
+      for (auto& [p, handler] : handlers) ::kill(p, SIGKILL);
     }
     ::usleep(10000);
   }

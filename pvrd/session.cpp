@@ -1,5 +1,6 @@
 #include "session.h"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
@@ -10,10 +11,12 @@
 #include <optional>
 #include <set>
 
+#include "admission.h"
 #include "auth.h"
 #include "catalog.h"
 #include "connect_back.h"
 #include "launcher.h"
+#include "out_buffer.h"
 #include "pvr_protocol.h"
 #include "sys.h"
 
@@ -33,19 +36,38 @@ constexpr double kMasterConnectSeconds = 60;
 constexpr std::size_t kMaxBeforeHello = proto::kHeaderBytes + proto::Limits{}.maxControlPayload;
 // How long a job's end waits for the launcher to exit and say why.
 constexpr double kLauncherEndSeconds = 5;
+// While more than this waits for the client, the master's socket is not
+// read: the job slows to the client's pace (one more read and one frame
+// being relayed come on top).
+constexpr std::size_t kClientBufferBytes = 16u << 20;
+// Requests that may wait for the master (before it connects, or while it
+// does not read): beyond it a request is refused, not buffered. Requests
+// are control frames and scenes (up to 4 MiB): a few of the largest, or
+// thousands of the usual ones. One request always fits.
+constexpr std::size_t kMasterBufferBytes = 16u << 20;
+// How long the last words to a leaving client (its Error, the Close) may
+// take to go out.
+constexpr double kFarewellSeconds = 1;
+
+void setNonBlocking(int fd) { ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) | O_NONBLOCK); }
 
 class Session {
  public:
-  Session(const SessionConfig& c, int fd) : cfg_(c), opt_(*c.options), client_(fd) {}
+  Session(const SessionConfig& c, int fd) : cfg_(c), opt_(*c.options), client_(fd), admission_(c.admission) {}
   int run();
 
  private:
   void log(const std::string& event) const { logEvent(cfg_.id, event); }
   bool sendClient(const proto::Message& m, std::uint32_t id, bool final = true);
   bool sendClientBytes(std::span<const std::uint8_t> frame);
-  // Writes bytes to the client's socket as they are (ciphertext, or frames
-  // before the secure channel).
+  // Queues bytes for the client's socket as they are (ciphertext, or
+  // frames before the secure channel) and writes what it takes now.
   bool writeClient(std::span<const std::uint8_t> bytes);
+  // Writes what waits for the client; false when it is gone.
+  bool flushClient();
+  // The client's last words (an Error, the Close) before the handler ends.
+  void farewell();
+  void markAuthenticated(const std::string& how);
   // The plaintext in bytes the client's socket gave: through the secure
   // channel once it runs. nullopt when the channel refused them (the
   // connection is then over).
@@ -65,6 +87,7 @@ class Session {
   void adoptMaster(ConnectBack::Master master, double now);
   void refuseMasterFrame(const proto::RefusedFrame& refused);
   void forward(const proto::Message& m, std::uint32_t id);
+  void flushMaster();
   bool launch(std::uint32_t ranks, const std::string& account, std::string& error);
   void onLaunchEvent(const LaunchEvent& event, double now);
   proto::StatusReply queuedStatus() const;
@@ -74,6 +97,9 @@ class Session {
   const SessionConfig& cfg_;
   const DaemonOptions& opt_;
   int client_;
+  AdmissionLink admission_;
+  bool holdsSlot_ = false;
+  OutBuffer toClient_, toMaster_;
   // With a token: every byte after Welcome travels in this channel keyed by
   // the token (docs/protocol.md, "The secure channel").
   std::unique_ptr<proto::SecureChannel> clientChannel_;
@@ -95,7 +121,9 @@ class Session {
   // while one is in flight the client waits for us, it is not idle.
   std::set<std::uint32_t> rendering_;
   bool greeted_ = false, authenticated_ = false, done_ = false;
+  // Plaintext for the master before it connected (bytes in all: pendingBytes_).
   std::deque<std::vector<std::uint8_t>> pendingToMaster_;
+  std::size_t pendingBytes_ = 0;
   double launchedAt_ = 0;
 };
 
@@ -124,22 +152,40 @@ std::optional<std::vector<std::uint8_t>> Session::clientPlaintext(std::span<cons
     done_ = true;
     return std::nullopt;
   }
-  if (!authenticated_ && clientChannel_->established()) {
-    authenticated_ = true;
-    log("authenticated (secure channel)");
-  }
+  if (!authenticated_ && clientChannel_->established()) markAuthenticated("authenticated (secure channel)");
   return clientChannel_->takeIncoming();
+}
+
+void Session::markAuthenticated(const std::string& how) {
+  authenticated_ = true;
+  admission_.authenticated();
+  log(how);
 }
 
 bool Session::writeClient(std::span<const std::uint8_t> bytes) {
   if (client_ < 0) return false;
+  toClient_.append(bytes, monotonicSeconds());
+  return flushClient();
+}
+
+bool Session::flushClient() {
+  if (client_ < 0) return false;
   std::string error;
-  if (writeAll(client_, bytes, error)) return true;
+  if (toClient_.flush(client_, monotonicSeconds(), error)) return true;
   log("client write failed: " + error);
   ::close(client_);
   client_ = -1;
   done_ = true;
   return false;
+}
+
+void Session::farewell() {
+  const double until = monotonicSeconds() + kFarewellSeconds;
+  while (client_ >= 0 && !toClient_.empty() && monotonicSeconds() < until) {
+    pollfd p{client_, POLLOUT, 0};
+    if (::poll(&p, 1, 50) < 0 && errno != EINTR) break;
+    if (!flushClient()) break;
+  }
 }
 
 void Session::endConnection(ErrorCode code, const std::string& text, std::uint32_t id) {
@@ -151,7 +197,18 @@ void Session::endConnection(ErrorCode code, const std::string& text, std::uint32
 
 void Session::forward(const proto::Message& m, std::uint32_t id) {
   auto bytes = proto::encode(m, id, 0);
+  // A job that does not take its requests gets no more of them: the
+  // client hears why instead of the handler's memory growing.
+  const std::size_t waiting = master_ < 0 ? pendingBytes_ : toMaster_.size();
+  if (waiting > 0 && waiting + bytes.size() > kMasterBufferBytes && !std::holds_alternative<proto::Close>(m)) {
+    if (rendering_.erase(id)) log("refused request " + std::to_string(id) + ": the job is not taking requests");
+    return replyError(ErrorCode::kLimitExceeded,
+                      std::to_string(waiting) + " bytes of requests already wait for the rendering job " +
+                          (master_ < 0 ? "to connect" : "to read them") + "; this one is dropped",
+                      id);
+  }
   if (master_ < 0) {
+    pendingBytes_ += bytes.size();
     pendingToMaster_.push_back(std::move(bytes));
     return;
   }
@@ -160,14 +217,20 @@ void Session::forward(const proto::Message& m, std::uint32_t id) {
 
 void Session::writeMaster(std::span<const std::uint8_t> plain) {
   if (auto failure = masterChannel_->send(plain)) return jobEnded("secure channel to the master: " + failure->text);
+  toMaster_.append(masterChannel_->takeOutgoing(), monotonicSeconds());
+  flushMaster();
+}
+
+void Session::flushMaster() {
   std::string error;
-  if (!writeAll(master_, masterChannel_->takeOutgoing(), error)) jobEnded("master write failed: " + error);
+  if (master_ >= 0 && !toMaster_.flush(master_, monotonicSeconds(), error)) jobEnded("master write failed: " + error);
 }
 
 void Session::onMasterCiphertext(std::span<const std::uint8_t> bytes) {
   const auto failure = masterChannel_->receive(bytes);
-  std::string error;
-  if (!writeAll(master_, masterChannel_->takeOutgoing(), error)) return jobEnded("master write failed: " + error);
+  toMaster_.append(masterChannel_->takeOutgoing(), monotonicSeconds());
+  flushMaster();
+  if (done_) return;
   if (failure) return jobEnded("secure channel to the master: " + failure->text);
   const std::vector<std::uint8_t> plain = masterChannel_->takeIncoming();
   if (!plain.empty()) onMasterBytes(plain);
@@ -196,7 +259,7 @@ void Session::onClient(proto::Decoded frame) {
       clientChannel_ = std::make_unique<proto::SecureChannel>(proto::SecureChannel::Role::kServer, cfg_.token,
                                                               proto::kClientPurpose);
     else
-      authenticated_ = true;
+      markAuthenticated("no token: the Hello admits the client");
     return;
   }
   if (!authenticated_) return endConnection(ErrorCode::kUnexpectedMessage, "authenticate first", id);
@@ -246,6 +309,13 @@ void Session::openSession(const proto::SessionOpen& open, std::uint32_t id) {
                                                         open.account.size())) +
                           "' may hold only A-Z a-z 0-9 _ . -",
                       id);
+  // The slot is the daemon's to give (admission.h); without one the
+  // client stays connected and may try again.
+  if (auto refused = admission_.requestSlot(opt_.maxSessions)) {
+    log("SessionOpen refused: " + *refused);
+    return replyError(ErrorCode::kLimitExceeded, *refused, id);
+  }
+  holdsSlot_ = true;
   std::string error;
   if (!launch(ranks, open.account, error)) {
     teardown();
@@ -300,6 +370,7 @@ void Session::refuseMasterFrame(const proto::RefusedFrame& refused) {
 
 void Session::adoptMaster(ConnectBack::Master master, double now) {
   master_ = master.fd;
+  setNonBlocking(master_);
   masterChannel_ = std::move(master.channel);
   connectBack_.reset();
   masterDeadline_ = 0;
@@ -308,6 +379,7 @@ void Session::adoptMaster(ConnectBack::Master master, double now) {
     writeMaster(pendingToMaster_.front());
     pendingToMaster_.pop_front();
   }
+  pendingBytes_ = 0;
   if (!done_ && !master.rest.empty()) onMasterBytes(master.rest);
 }
 
@@ -391,6 +463,11 @@ void Session::teardown() {
   rendering_.clear();
   openRequest_ = 0;
   masterDeadline_ = 0;
+  toMaster_ = OutBuffer{};
+  pendingToMaster_.clear();
+  pendingBytes_ = 0;
+  if (holdsSlot_) admission_.releaseSlot();
+  holdsSlot_ = false;
   if (!launcher_) return;
   const double t0 = monotonicSeconds();
   const pid_t pid = launcher_->pid();
@@ -400,18 +477,24 @@ void Session::teardown() {
 }
 
 int Session::run() {
-  setSendTimeout(client_, opt_.frameTimeout);
-  double lastFrame = monotonicSeconds();
+  setNonBlocking(client_);
+  const double acceptedAt = monotonicSeconds();
+  double lastFrame = acceptedAt;
   double frameStarted = 0;
   std::vector<std::uint8_t> buf(64 << 10);
   std::vector<pollfd> fds;
   while (!done_ && !gStop) {
-    // Poll the client, the master, the job's output, the connect-back.
+    // Poll the client, the master, the job's output, the connect-back. The
+    // client is always read, so its leaving is seen at once; the master is
+    // not read while its frames wait for a slow client.
     fds.clear();
     const std::size_t ci = fds.size();
-    if (client_ >= 0) fds.push_back({client_, POLLIN, 0});
+    if (client_ >= 0) fds.push_back({client_, short(POLLIN | (toClient_.empty() ? 0 : POLLOUT)), 0});
     const std::size_t mi = fds.size();
-    if (master_ >= 0) fds.push_back({master_, POLLIN, 0});
+    if (master_ >= 0) {
+      const bool take = toClient_.size() <= kClientBufferBytes;
+      fds.push_back({master_, short((take ? POLLIN : 0) | (toMaster_.empty() ? 0 : POLLOUT)), 0});
+    }
     const std::size_t oi = fds.size();
     if (launcher_ && launcher_->outputFd() >= 0) fds.push_back({launcher_->outputFd(), POLLIN, 0});
     const std::size_t bi = fds.size();
@@ -422,15 +505,23 @@ int Session::run() {
     const auto ready = [&](std::size_t i, std::size_t next) {
       return i < next && (fds[i].revents & (POLLIN | POLLHUP | POLLERR));
     };
+    const auto writable = [&](std::size_t i, std::size_t next) { return i < next && (fds[i].revents & POLLOUT); };
     if (::poll(fds.data(), nfds_t(fds.size()), 100) < 0 && errno != EINTR) {
       log(errnoText("poll"));
       break;
     }
     const double now = monotonicSeconds();
 
+    if (writable(ci, mi) && !flushClient()) break;
+    if (writable(mi, oi)) {
+      flushMaster();
+      if (done_) break;
+    }
+
     // The client: requests, the end of its stream, a stalled frame, idleness.
     if (ready(ci, mi)) {
       const ssize_t got = ::read(client_, buf.data(), buf.size());
+      if (got < 0 && (errno == EAGAIN || errno == EINTR)) continue;
       if (got <= 0) {
         // A frame left unfinished gets its error, in case the client still reads.
         if (const auto& e = fromClient_.endOfStream()) endConnection(e->code, e->text, 0);
@@ -476,8 +567,30 @@ int Session::run() {
       if (fromClient_.bufferedBytes() == 0) frameStarted = 0;
       else if (before == 0 || frameStarted == 0 || completed) frameStarted = now;
     }
+    // A stranger has a short while to show who it is (admission.h): it
+    // holds one of the few handshake places until then.
+    if (!authenticated_ && now - acceptedAt > opt_.handshakeTimeout) {
+      const std::string text =
+          "no authenticated Hello within " + std::to_string(int(opt_.handshakeTimeout)) + " s (--handshake-timeout)";
+      // Inside an unfinished secure channel no frame can be sent: just close.
+      if (clientChannel_) {
+        log("closing: " + text);
+        done_ = true;
+      } else {
+        endConnection(ErrorCode::kTimeout, text, 0);
+      }
+      break;
+    }
     if (frameStarted > 0 && now - frameStarted > opt_.frameTimeout) {
       endConnection(ErrorCode::kTimeout, "the rest of a started frame did not arrive in time", 0);
+      break;
+    }
+    // A client that takes nothing of what waits for it (not a slow one: a
+    // stopped one) cannot be told why; it is let go.
+    if (toClient_.stalledFor(now) > opt_.frameTimeout) {
+      log("closing: the client read nothing of " + std::to_string(toClient_.size()) + " waiting bytes for " +
+          std::to_string(int(opt_.frameTimeout)) + " s");
+      done_ = true;
       break;
     }
     // A client waiting for its allocation, or for frames it asked for, is
@@ -508,6 +621,7 @@ int Session::run() {
     // The master's frames, relayed.
     if (ready(mi, oi)) {
       const ssize_t got = ::read(master_, buf.data(), buf.size());
+      if (got < 0 && (errno == EAGAIN || errno == EINTR)) continue;
       if (got <= 0) {
         jobEnded("the master rank's connection closed");
         break;
@@ -523,6 +637,7 @@ int Session::run() {
     sendClient(proto::Close{"pvrd is shutting down"}, 0);
   }
   teardown();
+  farewell();
   if (client_ >= 0) ::close(client_);
   log("session ended");
   return 0;

@@ -339,17 +339,6 @@ TEST_CASE("a token file other users may read is refused, saying how to fix it") 
                     "make it private with: chmod 600 " + tokenFile.string()) != std::string::npos);
 }
 
-TEST_CASE("extra connections over --max-sessions get too many sessions") {
-  Daemon d(makeDataDir("maxsessions"));
-  Client a(d.port), b(d.port);
-  a.hello();
-  b.hello();
-  Client c(d.port);
-  const auto e = c.expectError(5);
-  CHECK(e.code == proto::ErrorCode::kLimitExceeded);
-  CHECK(e.text == "too many sessions");
-}
-
 TEST_CASE("a client stalled in the middle of a frame is timed out") {
   Daemon d(makeDataDir("stall"), {"--idle-timeout", "2"});
   Client c(d.port);

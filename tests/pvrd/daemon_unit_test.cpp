@@ -159,6 +159,14 @@ TEST_CASE("options parse listen address, limits and refuse a public bind without
   CHECK(o->port == 0);
   CHECK(o->maxRanks == 3);
   CHECK(o->idleTimeout == 5);
+  CHECK(o->handshakeTimeout == 10);
+  o = parseOptions({"--data-dir", "/d", "--max-unauthenticated", "3", "--max-connections", "9", "--handshake-timeout", "2"},
+                   error);
+  REQUIRE(o);
+  CHECK(o->maxUnauthenticated == 3);
+  CHECK(o->maxConnections == 9);
+  CHECK(o->handshakeTimeout == 2);
+  CHECK_FALSE(parseOptions({"--data-dir", "/d", "--max-unauthenticated", "0"}, error));
   CHECK_FALSE(parseOptions({"--listen", "0.0.0.0:7000", "--data-dir", "/d"}, error));
   CHECK(error.find("token") != std::string::npos);
   CHECK(parseOptions({"--listen", "0.0.0.0:7000", "--data-dir", "/d", "--token-file", "/t"}, error));
