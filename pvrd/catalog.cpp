@@ -94,7 +94,23 @@ std::variant<std::vector<proto::CatalogEntry>, proto::ProtocolError> listDataset
   if (!malformed.empty())
     return failed(ErrorCode::kIo, "malformed line '" + printable({reinterpret_cast<const std::uint8_t*>(malformed.data()),
                                                                   malformed.size()}, 80) + "'");
+  if (auto tooLarge = checkCatalogSize(entries)) return *tooLarge;
   return entries;
+}
+
+std::optional<proto::ProtocolError> checkCatalogSize(const std::vector<proto::CatalogEntry>& entries) {
+  // The reply as it would go out, measured by the codec, against the
+  // limit the protocol's message table gives CatalogReply: what a client
+  // would refuse is never sent (issue 15, finding 15).
+  proto::CatalogReply reply{entries};
+  const std::uint32_t limit = proto::payloadLimit(proto::messageInfo(reply), proto::Limits{});
+  const std::size_t payload = proto::encode(reply, 0).size() - proto::kHeaderBytes;
+  if (payload <= limit) return std::nullopt;
+  return proto::ProtocolError{ErrorCode::kLimitExceeded,
+                              "the catalog of " + std::to_string(entries.size()) + " datasets is " + std::to_string(payload) +
+                                  " bytes, over the protocol's limit of " + std::to_string(limit) +
+                                  " bytes for a catalog reply; serve fewer datasets from the data directory (a time "
+                                  "series counts once) or shorter names"};
 }
 
 std::variant<std::string, proto::ProtocolError> resolveDataset(const std::string& dataDir, const std::string& name) {

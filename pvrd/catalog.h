@@ -8,6 +8,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -26,10 +27,16 @@ inline constexpr double kCatalogSeconds = 20;
 // entries in the program's order (sorted by name), or the error for the
 // client: kIo when the program cannot start, fails or prints a malformed
 // line, kTimeout (the program killed) when it runs longer than
-// `timeoutSeconds`. Nothing it started is left running.
+// `timeoutSeconds`, kLimitExceeded when the reply would be larger than a
+// client accepts (checkCatalogSize). Nothing it started is left running.
 std::variant<std::vector<proto::CatalogEntry>, proto::ProtocolError> listDatasets(
     const std::string& nodePath, const std::string& dataDir, double timeoutSeconds,
     const std::function<void(const std::string&)>& note);
+
+// kLimitExceeded, naming the datasets, the bytes and the limit, when a
+// CatalogReply of `entries` would be over the protocol's payload limit for
+// it (protocol Limits, message_table.h's payloadLimit); nullopt when it fits.
+std::optional<proto::ProtocolError> checkCatalogSize(const std::vector<proto::CatalogEntry>& entries);
 
 // The real path of dataset `name` inside `dataDir`, or the error to send:
 // kBadArgument for an absolute name or one with a ".." component,

@@ -121,6 +121,21 @@ TEST_CASE("a catalog program that fails, is missing or prints nonsense gives an 
   CHECK_THAT(zero.text, Catch::Contains("malformed line"));
 }
 
+// Issue 15, finding 15: a catalog over 4 MiB was sent, and the client
+// (which must refuse it) lost its session. 40000 names of 131 bytes make a
+// reply of 5.6 MB; the protocol's limit for it is 4 MiB.
+TEST_CASE("a catalog reply over the protocol's limit is refused with LIMIT_EXCEEDED naming its size and the limit") {
+  const auto big = errorOf(listDatasets(
+      fakeNode("big", "awk 'BEGIN { for (i = 0; i < 40000; i++) printf \"1\\td%0125d.json\\n\", i }'"), "/d", 20,
+      [](const std::string&) {}));
+  CHECK(big.code == ErrorCode::kLimitExceeded);
+  CHECK_THAT(big.text, Catch::Contains("the catalog of 40000 datasets is 5560004 bytes, over the protocol's limit of "
+                                       "4194304 bytes for a catalog reply"));
+  // One that fits still lists.
+  const std::vector<pvr::proto::CatalogEntry> fits(1000, {std::string(100, 'd'), 1});
+  CHECK_FALSE(checkCatalogSize(fits));
+}
+
 TEST_CASE("a catalog program over its time limit is killed with its children and reported") {
   // 2 s: time for the script to write both pid files even on a loaded
   // machine (0.5 s failed once while a build ran beside it).
