@@ -7,7 +7,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 
 namespace pvr::tcl {
@@ -59,6 +61,8 @@ Connection::~Connection() {
 void Connection::closeSocket() {
   if (timer_) Tcl_DeleteTimerHandler(timer_);
   timer_ = nullptr;
+  if (frameTimer_) Tcl_DeleteTimerHandler(frameTimer_);
+  frameTimer_ = nullptr;
   if (fd_ >= 0) {
     Tcl_DeleteFileHandler(fd_);
     ::close(fd_);
@@ -89,6 +93,28 @@ void Connection::timeoutProc(ClientData data) {
   self->timer_ = nullptr;
   if (self->state_ == State::kConnecting)
     self->fail({"PVR", "CONNECT", "TIMEOUT"}, "cannot connect to " + self->peer_ + ": timed out");
+}
+
+void Connection::frameTimeoutProc(ClientData data) {
+  auto* self = static_cast<Connection*>(data);
+  self->frameTimer_ = nullptr;
+  char limit[32];
+  std::snprintf(limit, sizeof limit, "%g", self->frameTimeout_);
+  self->fail({"PVR", "PROTOCOL", "TIMEOUT"}, "protocol error from " + self->peer_ + ": a frame began and its rest did not arrive within " +
+                                               limit + " s (the session's -timeout); the session is closed");
+}
+
+void Connection::watchFrame() {
+  if (state_ != State::kConnected) return;
+  // A frame ended since the last look: the one in progress (if any) is new.
+  const std::uint64_t ended = intake_.framesEnded();
+  if (frameTimer_ && (ended != framesEndedSeen_ || !intake_.inFrame())) {
+    Tcl_DeleteTimerHandler(frameTimer_);
+    frameTimer_ = nullptr;
+  }
+  framesEndedSeen_ = ended;
+  if (intake_.inFrame() && !frameTimer_)
+    frameTimer_ = Tcl_CreateTimerHandler(int(std::min(frameTimeout_, 1e6) * 1000), frameTimeoutProc, this);
 }
 
 void Connection::fileProc(ClientData data, int mask) {
@@ -171,7 +197,7 @@ void Connection::readSome() {
   std::uint8_t buf[256 << 10];
   const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
   if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) return;
-  if (n > 0 && !channel_) decoder_.feed(std::span<const std::uint8_t>(buf, std::size_t(n)));
+  if (n > 0 && !channel_) intake_.feed(std::span<const std::uint8_t>(buf, std::size_t(n)));
   if (n > 0 && channel_) {
     const auto failure = channel_->receive(std::span<const std::uint8_t>(buf, std::size_t(n)));
     queue(channel_->takeOutgoing());  // handshake replies, or the alert that says why we stop
@@ -181,27 +207,32 @@ void Connection::readSome() {
       fail({"PVR", "AUTH", "FAILED"}, "cannot authenticate with " + peer_ + ": " + failure->text);
       return;
     }
-    decoder_.feed(channel_->takeIncoming());
+    intake_.feed(channel_->takeIncoming());
   }
   const std::shared_ptr<bool> alive = alive_;
-  while (auto message = decoder_.pop()) {
-    listener_.onMessage(*message);
+  while (auto item = intake_.pop()) {
+    if (const auto* message = std::get_if<proto::Decoded>(&*item))
+      listener_.onMessage(*message);
+    else
+      listener_.onRefused(std::get<FrameIntake::Refused>(*item));
     if (!*alive || state_ != State::kConnected) return;
   }
-  if (decoder_.error()) {
-    const auto& e = *decoder_.error();
+  if (intake_.error()) {
+    const auto& e = *intake_.error();
     fail({"PVR", "PROTOCOL", std::string(proto::errorCodeName(e.code))},
          "protocol error from " + peer_ + ": " + e.text);
     return;
   }
   if (n == 0) {
-    if (const auto& e = decoder_.endOfStream())
+    if (const auto& e = intake_.endOfStream())
       fail({"PVR", "PROTOCOL", std::string(proto::errorCodeName(e->code))},
            "protocol error from " + peer_ + ": " + e->text);
     else
       fail({"PVR", "CONNECT", "LOST"}, "connection to " + peer_ + " closed by the server");
   } else if (n < 0) {
     fail({"PVR", "CONNECT", "LOST"}, "connection to " + peer_ + " lost: " + std::strerror(errno));
+  } else {
+    watchFrame();
   }
 }
 

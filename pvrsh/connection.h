@@ -2,8 +2,10 @@
 //
 // Connecting, reading and writing all happen in Tcl file handlers
 // (Tcl_CreateFileHandler), so any number of connections and a Tk GUI stay
-// live at once. Bytes in go through a FrameDecoder; each decoded message is
-// handed to the Listener. Bytes out are queued and written as the socket
+// live at once. Bytes in go through a FrameIntake (frame_intake.h); each
+// decoded message is handed to the Listener, and so is each frame refused
+// whole for its size (the stream goes on after it). A frame that begins and
+// does not end within the frame timeout fails the connection. Bytes out are queued and written as the socket
 // accepts them. The connection never blocks the interpreter. Once
 // startSecure() is called every byte in and out goes through a
 // SecureChannel keyed by the token (docs/protocol.md, "The secure channel").
@@ -16,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "frame_intake.h"
 #include "pvr_protocol.h"
 #include "secure_channel.h"
 #include "tcl_util.h"
@@ -30,6 +33,7 @@ class Connection {
    public:
     virtual ~Listener() = default;
     virtual void onMessage(const proto::Decoded& message) = 0; // one decoded frame
+    virtual void onRefused(const FrameIntake::Refused& frame) = 0; // one frame too large, skipped
     virtual void onFailure(const TclError& error) = 0;         // once; the socket is closed after it
   };
 
@@ -53,6 +57,12 @@ class Connection {
   // server that is not pvrd) fails the connection with {PVR AUTH FAILED}.
   void startSecure(const std::string& token);
 
+  // How long the rest of a frame may take once its first byte is in
+  // (the session's -timeout); then the connection fails with
+  // {PVR PROTOCOL TIMEOUT}. The clock starts afresh with each frame, so a
+  // stream of frames that each arrive in time never trips it.
+  void setFrameTimeout(double seconds) { frameTimeout_ = seconds; }
+
   bool connected() const { return state_ == State::kConnected; }
   bool failed() const { return state_ == State::kFailed; }
 
@@ -61,6 +71,9 @@ class Connection {
 
   static void fileProc(ClientData data, int mask);
   static void timeoutProc(ClientData data);
+  static void frameTimeoutProc(ClientData data);
+  // Starts the half-frame timer when a frame has begun, stops it when none has.
+  void watchFrame();
   void finishConnect();
   void readSome();
   void writeSome();
@@ -76,10 +89,13 @@ class Connection {
   State state_ = State::kConnecting;
   int mask_ = 0;                          // file handler mask in force
   Tcl_TimerToken timer_ = nullptr;        // connect timeout
+  Tcl_TimerToken frameTimer_ = nullptr;   // half-frame timeout, while a frame is begun
+  double frameTimeout_ = 30;              // seconds; setFrameTimeout
+  std::uint64_t framesEndedSeen_ = 0;     // intake_.framesEnded() when the timer was last looked at
   std::vector<std::uint8_t> out_;         // bytes queued for the socket
   std::size_t outDone_ = 0;               // bytes of out_ already written
   std::unique_ptr<proto::SecureChannel> channel_;  // after startSecure()
-  proto::FrameDecoder decoder_;
+  FrameIntake intake_;
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);  // false once destroyed
 };
 

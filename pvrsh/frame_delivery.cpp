@@ -7,33 +7,53 @@
 
 namespace pvr::tcl {
 
-void Session::handleFrame(Sequence& seq, const proto::ImageFrame& f, bool final) {
-  const std::uint32_t id = seq.id;
-  FrameRecord r;
-  r.frame = f.frameNumber;
-  r.timing = f.timing;
-  r.arrival = seconds(Clock::now() - seq.sent);
-  r.width = int(f.width);
-  r.height = int(f.height);
-  seq.frames.push_back(r);
-  last_ = seq;
-  const std::uint64_t number = framesReceived_++;
-  const Pixels pixels = decodePixels(f);
-
-  // Sinks: the photo, then files, then the callback (which may look at both).
-  if (!photo_.empty()) putPhoto(interp_, photo_, pixels);
-  if (!dir_.empty()) writePng(pixels, numberedInDirectory(dir_, name_).name(number));
-  if (!files_.empty()) {
-    writePng(pixels, files_.name(number));
-    if (seq.frames.size() == 1) firstFileNumber_ = number;
+void Session::handleFrame(std::uint32_t id, const proto::ImageFrame& f, bool complete) {
+  // The frame is recorded (ReplyBook::route); a sink that fails ends the
+  // sequence with its error rather than leave it in flight for ever
+  // (issue 15, finding 14: a failure on the last frame kept every later
+  // `wait` busy).
+  const std::size_t count = book_.sequences.at(id).frames.size();
+  try {
+    const std::uint64_t number = framesReceived_++;
+    const Pixels pixels = decodePixels(f);
+    // Sinks: the photo, then files, then the callback (which may look at both).
+    if (!photo_.empty()) putPhoto(interp_, photo_, pixels);
+    if (!dir_.empty()) writePng(pixels, numberedInDirectory(dir_, name_).name(number));
+    if (!files_.empty()) {
+      writePng(pixels, files_.name(number));
+      if (count == 1) firstFileNumber_ = number;
+    }
+  } catch (const TclError& e) {
+    abandonSequence(id, complete, e);
+    return;
   }
-  if (progressOn(interp_)) printProgress(seq);
+  if (progressOn(interp_)) printProgress(book_.sequences.at(id));
   if (callback_) {
-    runImageCallback(r);
+    const FrameRecord record = book_.sequences.at(id).frames.back();  // the callback may add frames
+    runImageCallback(record);
     if (deleted_) return;  // the callback deleted this session
   }
-  const auto it = sequences_.find(id);
-  if (final || (it != sequences_.end() && it->second.frames.size() >= it->second.total)) finishSequence(id);
+  // The callback may have cancelled or closed: finishing is then done.
+  if (complete) finishSequence(id);
+}
+
+void Session::abandonSequence(std::uint32_t id, bool complete, const TclError& error) {
+  const auto it = book_.sequences.find(id);
+  if (it == book_.sequences.end()) return;
+  // Frames still to come are dropped, and the server stops making them.
+  if (!complete) {
+    book_.drop(id);
+    if (conn_ && conn_->connected()) {
+      try {
+        send(proto::Cancel{id}, false);
+      } catch (const TclError&) {
+        // The connection is going: its own failure is reported.
+      }
+    }
+  }
+  it->second.cancelled = true;
+  finishSequence(id);
+  report(error);
 }
 
 void Session::runImageCallback(const FrameRecord& r) {

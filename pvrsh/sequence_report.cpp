@@ -50,7 +50,7 @@ Tcl_Obj* timingDict(const FrameRecord& r) {
 
 Tcl_Obj* Session::timingObj() const {
   Tcl_Obj* list = Tcl_NewListObj(0, nullptr);
-  for (const auto& r : last_.frames) {
+  for (const auto& r : book_.latest().frames) {
     Tcl_Obj* d = timingDict(r);
     Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj("frame", -1), Tcl_NewWideIntObj(r.frame));
     Tcl_ListObjAppendElement(nullptr, list, d);

@@ -45,9 +45,9 @@ std::uint32_t Session::send(const proto::Message& message, bool synchronous) {
   const std::uint32_t id = nextId_++;
   if (!std::holds_alternative<proto::RenderFrame>(message) && !std::holds_alternative<proto::RenderRotation>(message) &&
       !std::holds_alternative<proto::RenderTimeSteps>(message))
-    pending_[id].synchronous = synchronous;
+    book_.expect(id, synchronous);
   if (!conn_ || !conn_->send(message, id)) {
-    pending_.erase(id);
+    book_.pending.erase(id);
     throw TclError({"PVR", "CONNECT", "LOST"}, "session " + name_ + ": the connection is gone");
   }
   return id;
@@ -62,12 +62,12 @@ std::vector<proto::Message> Session::query(const proto::Message& request, double
     // Until the FINAL answer, or (with onProgress) until one more answer.
     answered = runEventsUntil(
         [&] {
-          const auto it = pending_.find(id);
-          return it == pending_.end() || it->second.done || (onProgress && it->second.replies.size() > seen);
+          const auto it = book_.pending.find(id);
+          return it == book_.pending.end() || it->second.done || (onProgress && it->second.replies.size() > seen);
         },
         timeoutSeconds);
-    const auto it = pending_.find(id);
-    if (it == pending_.end()) break;
+    const auto it = book_.pending.find(id);
+    if (it == book_.pending.end()) break;
     // Progress: every answer but a FINAL one (an Error is kept apart), also
     // those that arrived together with it.
     const Pending& p = it->second;
@@ -75,10 +75,10 @@ std::vector<proto::Message> Session::query(const proto::Message& request, double
     while (onProgress && seen < progress) onProgress(p.replies[seen++]);
     if (!answered || p.done) break;
   }
-  const auto it = pending_.find(id);
-  if (it == pending_.end()) throw TclError({"PVR", "CONNECT", "LOST"}, "session " + name_ + ": the connection is gone");
+  const auto it = book_.pending.find(id);
+  if (it == book_.pending.end()) throw TclError({"PVR", "CONNECT", "LOST"}, "session " + name_ + ": the connection is gone");
   Pending p = std::move(it->second);
-  pending_.erase(it);
+  book_.pending.erase(it);
   if (!answered) throw TclError({"PVR", "TIMEOUT"}, "session " + name_ + ": no answer from " + peer_ + " in time");
   if (p.error) throw *p.error;
   return p.replies;
@@ -87,9 +87,7 @@ std::vector<proto::Message> Session::query(const proto::Message& request, double
 void Session::close(const std::string& reason) {
   if (conn_ && conn_->connected()) conn_->send(proto::Close{reason}, 0);
   conn_.reset();
-  pending_.clear();
-  for (auto& [id, seq] : sequences_) last_ = seq;
-  sequences_.clear();
+  book_.clear();
   state_ = State::kClosed;
 }
 
@@ -111,23 +109,18 @@ std::uint32_t Session::render(const proto::Message& request, std::uint32_t total
     layoutPending_ = false;
   }
   const std::uint32_t id = send(request, false);
-  Sequence& seq = sequences_[id];
-  seq.id = id;
-  seq.label = label;
-  seq.total = total;
-  seq.sent = Clock::now();
-  last_ = seq;
+  book_.start(id, label, total, Clock::now());
   return id;
 }
 
 int Session::cancel() {
   int n = 0;
   std::vector<std::uint32_t> ids;
-  for (auto& [id, seq] : sequences_) ids.push_back(id);
+  for (auto& [id, seq] : book_.sequences) ids.push_back(id);
   for (std::uint32_t id : ids) {
     if (conn_ && conn_->connected()) send(proto::Cancel{id}, false);
-    dropped_.insert(id);
-    sequences_[id].cancelled = true;
+    book_.drop(id);
+    book_.sequences[id].cancelled = true;
     finishSequence(id);
     ++n;
   }
@@ -141,16 +134,10 @@ std::size_t Session::wait(double timeoutSeconds) {
   // The sequence this wait reports: the oldest in flight, else one that
   // finished before the wait began (the event loop may have run it to the
   // end while another session was waited for) and no wait has reported.
-  const std::uint32_t firstId = !sequences_.empty() ? sequences_.begin()->first
-                                : last_.id > waitedId_ ? last_.id
-                                                       : nextId_;
-  const auto busy = [&] {
-    if (waitError_) return false;
-    if (!sequences_.empty()) return true;
-    for (const auto& [id, p] : pending_)
-      if (!p.synchronous && !p.done) return true;
-    return false;
-  };
+  const std::uint32_t firstId = !book_.sequences.empty()   ? book_.sequences.begin()->first
+                                : book_.latest().id > waitedId_ ? book_.latest().id
+                                                                : nextId_;
+  const auto busy = [&] { return !waitError_ && book_.busy(); };
   bool inTime = true;
   try {
     inTime = runEventsUntil([&] { return !busy(); }, timeoutSeconds);
@@ -162,9 +149,9 @@ std::size_t Session::wait(double timeoutSeconds) {
   --waiters_;
   std::optional<TclError> error;
   if (waiters_ == 0) std::swap(error, waitError_);
-  if (last_.id >= firstId) {
-    frames = last_.frames.size();
-    waitedId_ = last_.id;
+  if (const Sequence& latest = book_.latest(); latest.id >= firstId) {
+    frames = latest.frames.size();
+    waitedId_ = latest.id;
   }
   Tcl_Release(this);
   if (error) throw *error;

@@ -13,7 +13,8 @@
 // The methods live in one file per job:
 //   session.cpp           lifetime, requests out, waiting for answers
 //   session_open.cpp      open: connect, Hello, token challenge, SessionOpen
-//   session_arrivals.cpp  what comes back: replies, errors, the end of a sequence
+//   session_arrivals.cpp  what comes back: replies, errors, Close, the end of a sequence
+//   reply_book.cpp        which request a message answers, and the records kept (no Tcl)
 //   frame_delivery.cpp    a frame into the photo, files and the callback
 //   sequence_report.cpp   timings: progress lines, tables, Tcl dicts
 //   session_status.cpp    `list status` and the server's status entries
@@ -34,32 +35,13 @@
 #include <vector>
 
 #include "connection.h"
-#include "numbered_file.h"
 #include "frame_image.h"
+#include "numbered_file.h"
+#include "reply_book.h"
 #include "scene_options.h"
 #include "tcl_util.h"
 
 namespace pvr::tcl {
-
-using Clock = std::chrono::steady_clock;
-
-// One frame's record: the server's timing breakdown and when it arrived.
-struct FrameRecord {
-  std::uint32_t frame = 0;
-  proto::FrameTiming timing;
-  double arrival = 0;  // seconds since the request was sent
-  int width = 0, height = 0;
-};
-
-// A render request in flight: RenderFrame, RenderRotation or RenderTimeSteps.
-struct Sequence {
-  std::uint32_t id = 0;      // request id
-  std::string label;         // "rotate 0,1,0 15,59:60" for reports
-  std::uint32_t total = 0;   // frames expected
-  Clock::time_point sent;
-  std::vector<FrameRecord> frames;
-  bool cancelled = false;    // frames still arriving are dropped
-};
 
 // What `open` was asked for.
 struct OpenRequest {
@@ -68,16 +50,8 @@ struct OpenRequest {
   std::uint32_t ranks = 0;  // 0: the server's default
   std::string account;      // batch-system account; empty: the site's default
   std::string tokenFile;    // empty: no token
-  double timeout = 30;      // seconds for each step (at least 120 for the job to start)
-};
-
-// A request whose answer someone waits for (open, queries) or that only
-// reports failure (SetScene, SetLayout, Cancel).
-struct Pending {
-  bool synchronous = false;             // a caller runs the event loop for it
-  bool done = false;
-  std::vector<proto::Message> replies;  // every answer up to FINAL
-  std::optional<TclError> error;
+  double timeout = 30;      // seconds for each step (at least 120 for the job to start),
+                            // and for the rest of any frame once it has begun
 };
 
 class Session : public Connection::Listener {
@@ -116,6 +90,7 @@ class Session : public Connection::Listener {
 
   // ---- Connection::Listener ----
   void onMessage(const proto::Decoded& message) override;
+  void onRefused(const FrameIntake::Refused& frame) override;
   void onFailure(const TclError& error) override;
 
   Tcl_Interp* interp_;
@@ -137,7 +112,17 @@ class Session : public Connection::Listener {
   // The server's status entries, or nullopt when it cannot answer at once
   // (not open, or a sequence in flight: the master answers between waves).
   std::optional<std::vector<proto::KeyValue>> serverStatus();
-  void handleFrame(Sequence& seq, const proto::ImageFrame& frame, bool final);
+  // Does what one routed message asks (session_arrivals.cpp).
+  void act(Arrival& arrival);
+  // Delivers frame `frame` of sequence `id` to the sinks; a sink that fails
+  // ends the sequence with its error (frame_delivery.cpp).
+  void handleFrame(std::uint32_t id, const proto::ImageFrame& frame, bool complete);
+  // Ends sequence `id` early with `error`: its later frames are dropped and
+  // the server is asked to stop it (unless it had its last frame).
+  void abandonSequence(std::uint32_t id, bool complete, const TclError& error);
+  // Ends the session from inside an arrival: the connection closes, every
+  // request fails with `error`.
+  void endSession(const TclError& error);
   void runImageCallback(const FrameRecord& record);
   void finishSequence(std::uint32_t id);
   void report(const TclError& error);
@@ -157,10 +142,7 @@ class Session : public Connection::Listener {
   std::uint32_t ranks_ = 0;                       // started, as SessionReady said
   std::vector<proto::ClusterSpec> layout_;        // in force, as SessionReady said
   std::uint32_t nextId_ = 1;
-  std::map<std::uint32_t, Pending> pending_;
-  std::map<std::uint32_t, Sequence> sequences_;   // in flight, by request id
-  std::set<std::uint32_t> dropped_;               // cancelled ids whose answers are ignored
-  Sequence last_;                                 // the most recent sequence, finished or not
+  ReplyBook book_;                                // requests in flight, the latest sequence
   std::uint32_t waitedId_ = 0;                    // the last sequence whose count a wait returned
   std::uint64_t framesReceived_ = 0;              // numbers the files of `image dir|file`
   std::uint64_t firstFileNumber_ = 0;             // number of a sequence's first `image file` PNG
@@ -171,9 +153,6 @@ class Session : public Connection::Listener {
   bool layoutPending_ = false;                    // a layout set since open, sent with the next render
   bool deleted_ = false;
 };
-
-// Seconds in a duration, for timings.
-inline double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 // One frame's timing as the Tcl dict the image callback and `timing` give.
 Tcl_Obj* timingDict(const FrameRecord& record);

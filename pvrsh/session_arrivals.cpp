@@ -7,85 +7,87 @@
 
 namespace pvr::tcl {
 
-namespace {
-
-// Non-final replies one request may have (a SessionOpen waiting in a batch
-// queue gets one per change of state; nothing else gets more than a few).
-constexpr std::size_t kMaxRepliesPerRequest = 1000;
-
-}  // namespace
-namespace {
-
-TclError remoteError(const proto::ErrorMessage& e) {
-  const std::string code(proto::errorCodeName(e.code));
-  return TclError({"PVR", "REMOTE", code}, "server error " + code + ": " + e.text);
-}
-
-}  // namespace
-
 void Session::onMessage(const proto::Decoded& d) {
-  const std::uint32_t id = d.info.requestId;
   Tcl_Preserve(this);
   try {
-    if (id == 0) {
-      // About the connection itself: an Error, or Close. An Error here
-      // fails whatever waits (open's handshake); an open session reports it.
-      if (const auto* e = std::get_if<proto::ErrorMessage>(&d.message)) {
-        lastFailure_ = remoteError(*e);
-        for (auto& [pid, p] : pending_)
-          if (p.synchronous && !p.done) {
-            p.error = lastFailure_;
-            p.done = true;
-          }
-        if (state_ == State::kOpen) report(*lastFailure_);
-      }
-      if (const auto* c = std::get_if<proto::Close>(&d.message)) closeReason_ = c->reason;
-    } else if (dropped_.count(id)) {
-      if (d.info.final() || std::holds_alternative<proto::ErrorMessage>(d.message)) dropped_.erase(id);
-    } else if (auto s = sequences_.find(id); s != sequences_.end()) {
-      if (const auto* f = std::get_if<proto::ImageFrame>(&d.message)) {
-        handleFrame(s->second, *f, d.info.final());
-      } else if (const auto* e = std::get_if<proto::ErrorMessage>(&d.message)) {
-        finishSequence(id);
-        if (e->code != proto::ErrorCode::kCancelled) report(remoteError(*e));
-      } else {
-        finishSequence(id);
-        report(TclError({"PVR", "PROTOCOL", "UNEXPECTED_MESSAGE"}, "a render request was answered with a message that is no image"));
-      }
-    } else if (auto p = pending_.find(id); p != pending_.end()) {
-      Pending& pending = p->second;
-      if (const auto* e = std::get_if<proto::ErrorMessage>(&d.message)) {
-        pending.error = remoteError(*e);
-        pending.done = true;
-      } else {
-        if (const auto* r = std::get_if<proto::SessionReady>(&d.message)) {
-          ranks_ = r->rankCount;
-          layout_ = r->clusters;
-        }
-        if (pending.replies.size() >= kMaxRepliesPerRequest) {
-          // A server that never ends a request would grow this without
-          // bound (3.1 GiB in 7 s): the session ends instead.
-          onFailure(TclError({"PVR", "PROTOCOL", "LIMIT_EXCEEDED"},
-                             peer_ + " sent more than " + std::to_string(kMaxRepliesPerRequest) +
-                                 " replies to one request without ending it; the session is closed"));
-          conn_.reset();
-          return;
-        }
-        pending.replies.push_back(d.message);
-        pending.done = d.info.final();
-      }
-      if (pending.done && !pending.synchronous) {
-        const std::optional<TclError> error = pending.error;
-        pending_.erase(p);
-        if (error) report(*error);
-      }
+    Arrival arrival = book_.route(d, Clock::now());
+    if (const auto* r = std::get_if<proto::SessionReady>(&d.message); r && arrival.kind == Arrival::Kind::kAnswered) {
+      ranks_ = r->rankCount;
+      layout_ = r->clusters;
     }
+    act(arrival);
   } catch (const TclError& e) {
     report(e);
   } catch (const std::exception& e) {
     report(TclError({"PVR", "INTERNAL"}, e.what()));
   }
   Tcl_Release(this);
+}
+
+void Session::onRefused(const FrameIntake::Refused& frame) {
+  // A reply over pvrsh's limit (a catalog over 4 MiB): the connection
+  // skipped it, so only the request it answered fails.
+  Tcl_Preserve(this);
+  const std::string code(proto::errorCodeName(frame.error.code));
+  const std::string what = peer_ + " sent a " + std::string(frame.type) + " pvrsh refuses (" + frame.error.text + ")";
+  Arrival arrival = book_.refuse(frame.header.requestId, (frame.header.flags & proto::kFlagFinal) != 0,
+                                 TclError({"PVR", "PROTOCOL", code}, what + "; it was skipped and the session serves on"));
+  // Not the answer of a request pvrsh knows: what it missed cannot be told.
+  if (arrival.kind == Arrival::Kind::kConnectionError)
+    endSession(TclError({"PVR", "PROTOCOL", code}, what + "; the session is closed"));
+  else
+    act(arrival);
+  Tcl_Release(this);
+}
+
+void Session::act(Arrival& a) {
+  switch (a.kind) {
+    case Arrival::Kind::kIgnored:
+    case Arrival::Kind::kAnswered:
+      return;
+    case Arrival::Kind::kConnectionError:
+      // open's handshake fails with it; an open session reports it.
+      lastFailure_ = a.error;
+      if (state_ == State::kOpen) report(*a.error);
+      return;
+    case Arrival::Kind::kClosed: {
+      // The server ends the session, whether or not it closes the socket
+      // too: nothing more will be served. An Error it sent just before
+      // says why better than the Close does.
+      closeReason_ = a.reason;
+      TclError e({"PVR", "CONNECT", "CLOSED"}, "session " + name_ + ": " + peer_ + " closed the session: " +
+                                                   (a.reason.empty() ? std::string("no reason given") : a.reason));
+      if (lastFailure_ && lastFailure_->code().size() > 1 && lastFailure_->code()[1] == "REMOTE") e = *lastFailure_;
+      if (conn_ && conn_->connected()) conn_->send(proto::Close{"pvrsh: the server closed the session"}, 0);
+      endSession(e);
+      return;
+    }
+    case Arrival::Kind::kFrame:
+      handleFrame(a.id, *a.frame, a.complete);
+      return;
+    case Arrival::Kind::kSequenceEnded:
+      // A frame of it refused for its size ends it as a sink error does:
+      // the server is asked to stop. An Error or odd answer ended it already.
+      if (a.error && a.error->code().size() > 1 && a.error->code()[1] == "PROTOCOL" &&
+          a.error->code().back() == "FRAME_TOO_LARGE") {
+        abandonSequence(a.id, a.complete, *a.error);
+      } else {
+        finishSequence(a.id);
+        if (a.error) report(*a.error);
+      }
+      return;
+    case Arrival::Kind::kRequestDone:
+      if (a.error) report(*a.error);
+      return;
+    case Arrival::Kind::kTooManyReplies:
+      endSession(*a.error);
+      return;
+  }
+}
+
+void Session::endSession(const TclError& error) {
+  onFailure(error);
+  conn_.reset();
 }
 
 void Session::onFailure(const TclError& error) {
@@ -98,30 +100,24 @@ void Session::onFailure(const TclError& error) {
   const bool wasOpen = state_ == State::kOpen;
   state_ = State::kFailed;
   lastFailure_ = e;
-  for (auto& [id, p] : pending_)
-    if (!p.done) {
-      p.error = e;
-      p.done = true;
-    }
-  for (auto it = pending_.begin(); it != pending_.end();)
-    it = it->second.synchronous ? std::next(it) : pending_.erase(it);
-  const bool hadSequences = !sequences_.empty();
+  book_.failPending(e);
+  const bool hadSequences = !book_.sequences.empty();
   std::vector<std::uint32_t> ids;
-  for (const auto& [id, seq] : sequences_) ids.push_back(id);
+  for (const auto& [id, seq] : book_.sequences) ids.push_back(id);
   for (std::uint32_t id : ids) finishSequence(id);
   if (wasOpen || hadSequences) report(e);
   Tcl_Release(this);
 }
 
 void Session::finishSequence(std::uint32_t id) {
-  const auto it = sequences_.find(id);
-  if (it == sequences_.end()) return;
-  Sequence seq = std::move(it->second);
-  sequences_.erase(it);
-  last_ = seq;
-  if (progressOn(interp_) && !seq.frames.empty()) printTable(seq);
-  if (!files_.empty() && !seq.cancelled) assembleAnimation(seq);
-  notify(seq.cancelled ? "cancelled" : "done", {Tcl_NewWideIntObj(Tcl_WideInt(seq.frames.size()))});
+  std::optional<Sequence> seq = book_.finish(id);
+  if (!seq) return;
+  const std::size_t frames = seq->frames.size();
+  const bool cancelled = seq->cancelled;
+  if (progressOn(interp_) && frames > 0) printTable(*seq);
+  if (!files_.empty() && !cancelled) assembleAnimation(*seq);
+  book_.remember(std::move(*seq));
+  notify(cancelled ? "cancelled" : "done", {Tcl_NewWideIntObj(Tcl_WideInt(frames))});
 }
 
 void Session::report(const TclError& error) {

@@ -54,13 +54,14 @@ void Session::open(const OpenRequest& request) {
   try {
     // Step 1: TCP connect on the event loop.
     conn_.reset();
-    pending_.clear();
-    sequences_.clear();
+    book_.clear();
+    book_.setPeer(request.host + ":" + std::to_string(request.port));
     closeReason_.clear();
     lastFailure_.reset();
     state_ = State::kConnecting;
     peer_ = request.host + ":" + std::to_string(request.port);
     conn_ = std::make_unique<Connection>(*this, request.host, request.port, std::min(timeout, 30.0));
+    conn_->setFrameTimeout(timeout);
     runEventsUntil([&] { return !conn_ || conn_->connected() || conn_->failed(); }, timeout);
     if (!conn_ || !conn_->connected()) {
       if (conn_ && !conn_->failed())
@@ -105,7 +106,7 @@ void Session::open(const OpenRequest& request) {
   } catch (...) {
     if (!deleted_) {
       conn_.reset();
-      pending_.clear();
+      book_.pending.clear();
       state_ = State::kFailed;
     }
     Tcl_Release(this);

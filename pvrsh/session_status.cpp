@@ -7,7 +7,7 @@ namespace pvr::tcl {
 std::optional<std::vector<proto::KeyValue>> Session::serverStatus() {
   // With a sequence in flight the master answers only between waves, so
   // the answer could wait for a whole frame: not asked then.
-  if (state_ != State::kOpen || !sequences_.empty()) return std::nullopt;
+  if (state_ != State::kOpen || !book_.sequences.empty()) return std::nullopt;
   std::vector<proto::KeyValue> entries;
   for (const auto& m : query(proto::StatusRequest{}, 30))
     if (const auto* r = std::get_if<proto::StatusReply>(&m)) entries.insert(entries.end(), r->entries.begin(), r->entries.end());
@@ -57,11 +57,12 @@ Tcl_Obj* Session::statusObj() {
   put("file", str(files_.pattern()));
   put("dir", str(dir_));
   put("frames_received", Tcl_NewWideIntObj(Tcl_WideInt(framesReceived_)));
-  put("busy", Tcl_NewBooleanObj(!sequences_.empty()));
+  put("busy", Tcl_NewBooleanObj(!book_.sequences.empty()));
   Tcl_Obj* seq = Tcl_NewDictObj();
-  Tcl_DictObjPut(nullptr, seq, Tcl_NewStringObj("request", -1), str(last_.label));
-  Tcl_DictObjPut(nullptr, seq, Tcl_NewStringObj("done", -1), Tcl_NewWideIntObj(Tcl_WideInt(last_.frames.size())));
-  Tcl_DictObjPut(nullptr, seq, Tcl_NewStringObj("total", -1), Tcl_NewWideIntObj(last_.total));
+  const Sequence& latest = book_.latest();
+  Tcl_DictObjPut(nullptr, seq, Tcl_NewStringObj("request", -1), str(latest.label));
+  Tcl_DictObjPut(nullptr, seq, Tcl_NewStringObj("done", -1), Tcl_NewWideIntObj(Tcl_WideInt(latest.frames.size())));
+  Tcl_DictObjPut(nullptr, seq, Tcl_NewStringObj("total", -1), Tcl_NewWideIntObj(latest.total));
   put("sequence", seq);
   Tcl_Obj* remote = Tcl_NewDictObj();
   if (entries)

@@ -15,18 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "tcl_error.h"
+
 namespace pvr::tcl {
-
-// A Tcl error: the message and the -errorcode list, e.g. {PVR ARGS IMAGESZ}.
-class TclError : public std::runtime_error {
- public:
-  TclError(std::vector<std::string> code, const std::string& message)
-      : std::runtime_error(message), code_(std::move(code)) {}
-  const std::vector<std::string>& code() const { return code_; }
-
- private:
-  std::vector<std::string> code_;
-};
 
 // Throws TclError{{"PVR", "ARGS", what}, message}.
 [[noreturn]] void argsError(const std::string& what, const std::string& message);

@@ -1,9 +1,14 @@
 # A stand-in pvrd for tests of what pvrsh does with answers a real pvrd
 # gives only in situations a test cannot make at will (a session waiting in
-# a Slurm queue). It listens on 127.0.0.1, speaks the frames of
+# a Slurm queue), and with a hostile or broken server (frames pvrsh cannot
+# deliver, a Close that leaves the socket open, half a frame, a catalog over
+# the protocol's limit). It listens on 127.0.0.1, speaks the frames of
 # docs/protocol.md in Tcl on the test's own event loop, answers Hello with
-# Welcome, SessionOpen with the frames the test scripted, and StatusRequest
-# as a master of three ranks on two hosts would (state, hosts).
+# Welcome, SessionOpen with the frames the test scripted, StatusRequest as
+# a master of three ranks on two hosts would (state, hosts), SetScene and
+# SetLayout with Ok, Cancel with Ok, CatalogRequest with a catalog of
+# ::fakepvrd::catalogBytes payload bytes (0: one dataset, "ball"), and each
+# render request with its frames, 2 x 2 RGB8, as ::fakepvrd::renders says.
 #
 #   set port [::fakepvrd::start {{progress {state queued batch_job 12 reason Priority}} ready}]
 #   ... :s open 127.0.0.1:$port ...
@@ -13,22 +18,34 @@
 # `ready` sends SessionReady, `error CODE TEXT` sends Error; each carries
 # the SessionOpen's request id. ::fakepvrd::received holds, per request the
 # server read, {type id fields}: for SessionOpen the fields are
-# {rankCount clusterCount account}.
-
+# {rankCount clusterCount account}, for Cancel {target}, for a render
+# {frames}.
+#
+# ::fakepvrd::renders: one entry per render request, in order (requests
+# past the list get `frames {}`):
+#   frames BAD   every frame of the request; those numbered in the list BAD
+#                have zlib pixels that do not decompress
+#   close REASON Close (request id 0) instead of frames; the socket stays open
+#   half         the header and part of the first frame's payload, then nothing
 namespace eval ::fakepvrd {
     variable listen ""
     variable script {}
     variable received {}
     variable buffers
     array set buffers {}
-    variable types {Hello 0x01 Welcome 0x02 Error 0x06 SessionOpen 0x10 SessionReady 0x11 StatusReply 0x31}
+    variable types {Hello 0x01 Welcome 0x02 Ok 0x05 Error 0x06 Close 0x07 SessionOpen 0x10 SessionReady 0x11
+        ImageFrame 0x22 StatusReply 0x31 CatalogReply 0x35}
+    variable renders {}
+    variable catalogBytes 0
 }
 
 # ::fakepvrd::start SCRIPT: listens on an ephemeral loopback port; returns it.
-proc ::fakepvrd::start {script} {
+proc ::fakepvrd::start {script {renders {}} {catalogBytes 0}} {
     variable listen
     variable received {}
     set ::fakepvrd::script $script
+    set ::fakepvrd::renders $renders
+    set ::fakepvrd::catalogBytes $catalogBytes
     set listen [socket -server ::fakepvrd::accept -myaddr 127.0.0.1 0]
     return [lindex [fconfigure $listen -sockname] 2]
 }
@@ -128,8 +145,83 @@ proc ::fakepvrd::request {ch type id payload} {
             lappend received [list StatusRequest $id {}]
             send $ch StatusReply $id 1 [binary format i 2][str state][str {session open}][str hosts][str {h1 h1 h2}]
         }
+        18 - 19 {
+            # SetScene, SetLayout: accepted.
+            lappend received [list $type $id {}]
+            send $ch Ok $id 1 ""
+        }
+        32 - 33 - 36 {
+            # RenderFrame (1 frame), RenderRotation (E - S + 1), RenderTimeSteps.
+            set count 1
+            if {$type == 33} {
+                binary scan $payload @24ii start end
+                set count [expr {$end - $start + 1}]
+            } elseif {$type == 36} {
+                binary scan $payload iuiuiu first last stride
+                set count [expr {($last - $first) / $stride + 1}]
+            }
+            lappend received [list Render $id $count]
+            render $ch $id $count
+        }
+        35 {
+            # Cancel: u32 target. Ok, as pvrd answers it.
+            binary scan $payload iu target
+            lappend received [list Cancel $id $target]
+            send $ch Ok $id 1 ""
+        }
+        52 {
+            lappend received [list CatalogRequest $id {}]
+            send $ch CatalogReply $id 1 [catalog]
+        }
         default {
             lappend received [list $type $id {}]
         }
     }
+}
+
+# An ImageFrame payload: frame NUMBER, 2 x 2 RGB8; BAD: zlib pixels that
+# do not decompress (fewer bytes than raw, so the frame itself is valid).
+proc ::fakepvrd::imageFrame {number bad} {
+    if {$bad} {
+        set compression 2
+        set pixels [binary format c5 {1 2 3 4 5}]
+    } else {
+        set compression 0
+        set pixels [binary format c12 {10 20 30 40 50 60 70 80 90 100 110 120}]
+    }
+    return [binary format iiiccqqqqqqq $number 2 2 0 $compression 0 0 0 0.01 0 0 0][binary format i [string length $pixels]]$pixels
+}
+
+proc ::fakepvrd::render {ch id count} {
+    variable renders
+    set what {frames {}}
+    if {[llength $renders] > 0} {
+        set what [lindex $renders 0]
+        set renders [lrange $renders 1 end]
+    }
+    switch -- [lindex $what 0] {
+        frames {
+            for {set k 0} {$k < $count} {incr k} {
+                send $ch ImageFrame $id [expr {$k == $count - 1}] [imageFrame $k [expr {$k in [lindex $what 1]}]]
+            }
+        }
+        close {
+            send $ch Close 0 1 [str [lindex $what 1]]
+        }
+        half {
+            set frame [frame ImageFrame $id 1 [imageFrame 0 0]]
+            puts -nonewline $ch [string range $frame 0 [expr {16 + 20 - 1}]]
+            flush $ch
+        }
+    }
+}
+
+# A CatalogReply payload: one dataset, "ball", or with catalogBytes > 0 one
+# whose name makes the payload exactly that long (u32 count, str name, u32 steps).
+proc ::fakepvrd::catalog {} {
+    variable catalogBytes
+    if {$catalogBytes <= 0} {
+        return [binary format i 1][str ball][binary format i 1]
+    }
+    return [binary format i 1][str [string repeat d [expr {$catalogBytes - 12}]]][binary format i 1]
 }
