@@ -40,19 +40,20 @@ void Session::handleFrame(std::uint32_t id, const proto::ImageFrame& f, bool com
 void Session::abandonSequence(std::uint32_t id, bool complete, const TclError& error) {
   const auto it = book_.sequences.find(id);
   if (it == book_.sequences.end()) return;
-  // Frames still to come are dropped, and the server stops making them.
-  if (!complete) {
-    book_.drop(id);
-    if (conn_ && conn_->connected()) {
-      try {
-        send(proto::Cancel{id}, false);
-      } catch (const TclError&) {
-        // The connection is going: its own failure is reported.
-      }
+  // The sequence ends first, whatever sending the Cancel then meets; the
+  // frames still to come are dropped.
+  it->second.cancelled = true;
+  if (!complete) book_.drop(id);
+  finishSequence(id);
+  // The server stops making them (the `done` notification may have closed
+  // or deleted the session: then there is no one to tell).
+  if (!complete && conn_ && conn_->connected()) {
+    try {
+      send(proto::Cancel{id}, false);
+    } catch (const TclError&) {
+      // The connection is going: its own failure is reported.
     }
   }
-  it->second.cancelled = true;
-  finishSequence(id);
   report(error);
 }
 

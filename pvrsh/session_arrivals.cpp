@@ -58,8 +58,11 @@ void Session::act(Arrival& a) {
       TclError e({"PVR", "CONNECT", "CLOSED"}, "session " + name_ + ": " + peer_ + " closed the session: " +
                                                    (a.reason.empty() ? std::string("no reason given") : a.reason));
       if (lastFailure_ && lastFailure_->code().size() > 1 && lastFailure_->code()[1] == "REMOTE") e = *lastFailure_;
+      // The session ends first, then pvrsh answers with its own Close
+      // (docs/protocol.md) and closes the socket.
+      onFailure(e);
       if (conn_ && conn_->connected()) conn_->send(proto::Close{"pvrsh: the server closed the session"}, 0);
-      endSession(e);
+      conn_.reset();
       return;
     }
     case Arrival::Kind::kFrame:
@@ -91,7 +94,9 @@ void Session::endSession(const TclError& error) {
 }
 
 void Session::onFailure(const TclError& error) {
-  if (deleted_) return;
+  // Once: a session that ended (a Close, a flood) and then fails to send
+  // its goodbye has nothing more to report.
+  if (deleted_ || state_ == State::kFailed) return;
   Tcl_Preserve(this);
   // A server's Error that preceded the close says more than "connection lost".
   TclError e = lastFailure_ && lastFailure_->code().size() > 1 && lastFailure_->code()[1] == "REMOTE" ? *lastFailure_ : error;
