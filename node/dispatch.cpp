@@ -12,6 +12,7 @@ namespace {
 // Runs `action` on this rank, then agrees with every other rank.
 std::optional<comm::Failure> runAgreeing(NodeState& state, const std::function<void()>& action) {
   std::optional<comm::Failure> mine;
+  if (state.liveness) ++state.liveness->progress;  // an action started: this rank is not hung
   try {
     action();
   } catch (...) {

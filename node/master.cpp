@@ -17,15 +17,10 @@ using proto::ErrorCode;
 // cache holds is no use, and the list travels with every wave.
 constexpr int kReadAheadFrames = 32;
 
-// Requests kept for after a sequence: a client that floods them during a
-// render gets LIMIT_EXCEEDED for the rest instead of growing rank 0's
-// memory without bound (1.76 GiB in 18 s before).
-constexpr std::size_t kMaxPendingRequests = 64;
-
-// Requests the master answers between the waves of a sequence.
-bool answeredAtOnce(const proto::Message& m) {
-  return std::holds_alternative<proto::StatusRequest>(m) || std::holds_alternative<proto::PerformanceRequest>(m) ||
-         std::holds_alternative<proto::Cancel>(m);
+// Requests the master answers between the waves of a sequence (Status and
+// Cancel the link thread answers at once).
+bool answeredBetweenWaves(const proto::Message& m) {
+  return std::holds_alternative<proto::StatusRequest>(m) || std::holds_alternative<proto::PerformanceRequest>(m);
 }
 
 void requireDataset(const NodeState& state) {
@@ -35,17 +30,15 @@ void requireDataset(const NodeState& state) {
 }  // namespace
 
 void Master::serve() {
-  while (link_.open()) {
-    std::optional<proto::Decoded> frame;
-    if (!pending_.empty()) {
-      frame = std::move(pending_.front());
-      pending_.pop_front();
-    } else {
-      frame = link_.next(true);
-    }
-    if (!frame) break;
+  publishStatus();
+  while (auto frame = link_.take()) {
     handle(*frame);
+    publishStatus();
   }
+}
+
+void Master::publishStatus() {
+  link_.publishStatus(proto::StatusReply{statusEntries(state_, {running_ != 0, framesSent_, scene_.settings})});
 }
 
 void Master::handle(const proto::Decoded& frame) {
@@ -131,11 +124,9 @@ void Master::on(const proto::PerformanceRequest& p, std::uint32_t id) {
   send(proto::PerformanceReply{p.query, state_.reply.dump()}, id);
 }
 
-void Master::on(const proto::Cancel& m, std::uint32_t id) {
-  // Requests run one at a time: any target but the running one has finished.
-  if (running_ != 0 && m.target == running_) cancelled_ = true;
-  send(proto::Ok{}, id);
-}
+// The link thread answers Cancel itself (pvrd_link_thread.h); one that
+// reaches here named nothing running.
+void Master::on(const proto::Cancel&, std::uint32_t id) { send(proto::Ok{}, id); }
 
 void Master::on(const proto::Close&, std::uint32_t) { link_.close(); }
 
@@ -147,10 +138,16 @@ void Master::on(const M&, std::uint32_t id) {
 void Master::renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf,
                             const std::function<int(int)>& stepOf, std::uint32_t id) {
   running_ = id;
-  cancelled_ = false;
+  publishStatus();
+  link_.setRendering(id);
+  std::uint32_t sent = 0;  // frames of this request
   state_.sendFrame = [&](proto::ImageFrame&& f, bool final) {
     ++framesSent_;
+    ++sent;
     send(f, id, final);
+  };
+  const auto sendCancelled = [&] {
+    send(proto::ErrorMessage{ErrorCode::kCancelled, "cancelled after " + std::to_string(sent) + " frames"}, id);
   };
   const int groups = state_.layout.groups;
   for (int first = 0; first < count && link_.open(); first += groups) {
@@ -162,26 +159,21 @@ void Master::renderSequence(int count, const std::function<core::CameraSpec(int)
     for (int k = first + groups; k < std::min(count, first + groups + kReadAheadFrames * groups); ++k)
       wave.upcoming.push_back(stepOf(k));
     if (auto f = invoke(state_, wave)) {
-      sendError(wireError(*f, state_.hosts), id);
+      // A frame stopped by the Cancel fails the wave on every rank alike.
+      if (link_.cancelled(id)) sendCancelled();
+      else sendError(wireError(*f, state_.hosts), id);
       break;
     }
-    // Between waves: answer what must not wait; keep the rest for later.
-    while (auto frame = link_.next(false)) {
-      if (answeredAtOnce(frame->message)) handle(*frame);
-      else if (pending_.size() < kMaxPendingRequests) pending_.push_back(std::move(*frame));
-      else
-        sendError(proto::ProtocolError{ErrorCode::kLimitExceeded,
-                                       "more than " + std::to_string(kMaxPendingRequests) +
-                                           " requests wait for the sequence in progress; this one is dropped"},
-                  frame->info.requestId);
-    }
-    if (cancelled_ && first + groups < count) {
-      send(proto::ErrorMessage{ErrorCode::kCancelled, "cancelled after " + std::to_string(first + groups) + " frames"},
-           id);
+    publishStatus();
+    // Between waves: answer what must not wait; the rest stays queued.
+    while (auto frame = link_.takeIf(answeredBetweenWaves)) handle(*frame);
+    if (link_.cancelled(id) && first + groups < count) {
+      sendCancelled();
       break;
     }
   }
   state_.sendFrame = nullptr;
+  link_.setRendering(0);
   running_ = 0;
 }
 

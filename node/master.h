@@ -1,9 +1,9 @@
-// The master rank's side of a session: it reads protocol messages from its
-// link to the pvrd session handler and answers each, turning the work into
+// The master rank's side of a session: it takes protocol requests from its
+// link thread (pvrd_link_thread.h) and answers each, turning the work into
 // actions every rank runs (dispatch.h, actions/table.h). Requests run one
-// at a time, in order. While a sequence renders, between its waves, the
-// master answers Status, Performance and Cancel at once and keeps any
-// other request for after the sequence.
+// at a time, in order. While a sequence renders, the link thread answers
+// Status and Cancel at once; between waves the master answers queued
+// Performance requests and keeps any other request for after the sequence.
 #pragma once
 
 #include <cstdint>
@@ -11,14 +11,14 @@
 #include <functional>
 
 #include "node.h"
-#include "pvrd_link.h"
+#include "pvrd_link_thread.h"
 #include "scene_patch.h"
 
 namespace pvr::node {
 
 class Master {
  public:
-  Master(NodeState& state, PvrdLink& link) : state_(state), link_(link) {}
+  Master(NodeState& state, LinkThread& link) : state_(state), link_(link) {}
   // Serves until the link closes or the client sends Close.
   void serve();
 
@@ -27,6 +27,8 @@ class Master {
   void sendError(const proto::ProtocolError& e, std::uint32_t id) { send(proto::ErrorMessage{e.code, e.text}, id); }
   // Answers one request; an error it throws becomes the request's Error.
   void handle(const proto::Decoded& frame);
+  // What the link thread answers a Status with while a render runs.
+  void publishStatus();
 
   // One handler per message the master serves, `id` the request's; the
   // template answers every other message with Error UNSUPPORTED.
@@ -53,12 +55,10 @@ class Master {
                       const std::function<int(int)>& stepOf, std::uint32_t id);
 
   NodeState& state_;
-  PvrdLink& link_;
-  std::deque<proto::Decoded> pending_;  // requests that arrived during a sequence
+  LinkThread& link_;
   SessionScene scene_;
   std::uint32_t framesSent_ = 0;
   std::uint32_t running_ = 0;  // request id of the sequence in progress; 0: none
-  bool cancelled_ = false;
 };
 
 }  // namespace pvr::node

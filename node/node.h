@@ -24,6 +24,7 @@
 #include "image.h"
 #include "io/volume_io.h"
 #include "layout.h"
+#include "liveness.h"
 #include "pvr_protocol.h"
 #include "raycast/raycaster.h"
 #include "runtime_settings.h"
@@ -33,6 +34,8 @@
 #include "thread_pool.h"
 
 namespace pvr::node {
+
+class RankWatch;
 
 // One frame of the wave in flight, as this rank sees it.
 struct WaveFrame {
@@ -68,6 +71,10 @@ struct NodeState {
   // (hosts.h): status `hosts`, and the host in a rank's failure text.
   std::vector<std::string> hosts;
   bool running = true;
+  // The server's watch (rank_watch.h) and what it watches of this rank;
+  // null in batch mode and tests.
+  comm::Liveness* liveness = nullptr;
+  RankWatch* watch = nullptr;
 
   // Layout.
   Layout layout;

@@ -5,6 +5,7 @@
 #include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/socket.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -66,15 +67,37 @@ void PvrdLink::close() {
 
 void PvrdLink::flush() {
   const std::vector<std::uint8_t> bytes = channel_->takeOutgoing();
-  std::size_t done = 0;
-  while (open_ && done < bytes.size()) {
-    const ssize_t n = ::send(fd_, bytes.data() + done, bytes.size() - done, MSG_NOSIGNAL);
+  out_.insert(out_.end(), bytes.begin(), bytes.end());
+  writeSome();
+  while (blocking_ && open_ && unwritten() > 0) {
+    pollfd p{fd_, POLLOUT, 0};
+    if (::poll(&p, 1, -1) < 0 && errno != EINTR) open_ = false;
+    writeSome();
+  }
+}
+
+void PvrdLink::stopBlocking() {
+  blocking_ = false;
+  if (fd_ >= 0) ::fcntl(fd_, F_SETFL, ::fcntl(fd_, F_GETFL) | O_NONBLOCK);
+}
+
+void PvrdLink::writeSome() {
+  while (open_ && unwritten() > 0) {
+    const ssize_t n = ::send(fd_, out_.data() + outDone_, unwritten(), MSG_NOSIGNAL | MSG_DONTWAIT);
     if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return;
     if (n <= 0) {
       open_ = false;
       return;
     }
-    done += std::size_t(n);
+    outDone_ += std::size_t(n);
+  }
+  if (outDone_ == out_.size()) {
+    out_.clear();
+    outDone_ = 0;
+  } else if (outDone_ > (1u << 20)) {  // drop what went out, so out_ holds only what has not
+    out_.erase(out_.begin(), out_.begin() + std::ptrdiff_t(outDone_));
+    outDone_ = 0;
   }
 }
 
@@ -88,6 +111,7 @@ bool PvrdLink::readSome(int timeoutMs) {
     std::uint8_t buf[64 << 10];
     const ssize_t n = ::read(fd_, buf, sizeof buf);
     if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return true;
     if (n <= 0) return open_ = false;
     const auto failure = channel_->receive(std::span(buf, std::size_t(n)));
     flush();  // handshake replies, or the alert that says why we stop

@@ -30,7 +30,16 @@ class PvrdLink {
   PvrdLink& operator=(const PvrdLink&) = delete;
 
   bool open() const { return open_; }
-  // Sends one message; a failed write closes the link.
+  int fd() const { return fd_; }
+  // From now on writes never block: what the socket does not take stays
+  // in the link (unwritten()) until writeSome() is called when the socket
+  // can take more. The link thread (pvrd_link_thread.h) switches to this
+  // once the handshake and JobHello are through.
+  void stopBlocking();
+  std::size_t unwritten() const { return out_.size() - outDone_; }
+  void writeSome();
+  // Sends one message (queues it, without blocking, after stopBlocking());
+  // a failed write closes the link.
   void send(const proto::Message& m, std::uint32_t id, bool final = true);
   // Sends bytes already framed (a refusal before the session starts).
   void sendRaw(std::span<const std::uint8_t> bytes);
@@ -42,7 +51,8 @@ class PvrdLink {
   void close();
 
  private:
-  // Writes everything the channel has for the socket; a failed write
+  // Moves what the channel has for the socket to out_ and writes it: all
+  // of it while blocking, else what the socket takes now. A failed write
   // closes the link.
   void flush();
   // Reads what the socket has (waiting up to timeoutMs, -1 for ever) into
@@ -51,8 +61,11 @@ class PvrdLink {
 
   int fd_ = -1;
   bool open_ = false;
+  bool blocking_ = true;
   std::unique_ptr<proto::SecureChannel> channel_;
   proto::FrameDecoder decoder_;
+  std::vector<std::uint8_t> out_;  // ciphertext for the socket; the first outDone_ bytes are written
+  std::size_t outDone_ = 0;
 };
 
 }  // namespace pvr::node

@@ -1,6 +1,8 @@
 #include "server_mode.h"
 
+#include <atomic>
 #include <climits>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -11,6 +13,8 @@
 #include "master.h"
 #include "mpi_communicator.h"
 #include "pvrd_link.h"
+#include "pvrd_link_thread.h"
+#include "rank_watch.h"
 
 namespace pvr::node {
 
@@ -33,12 +37,21 @@ std::string takeJobSecret() {
 
 int runServer(const ServerOptions& options) {
   const std::string secret = takeJobSecret();
-  comm::MpiEnvironment mpi(nullptr, nullptr);
+  // The watch thread calls MPI beside the main thread (rank_watch.h).
+  std::unique_ptr<comm::MpiEnvironment> environment;
+  try {
+    environment = std::make_unique<comm::MpiEnvironment>(nullptr, nullptr, comm::MpiEnvironment::Threads::kWatched);
+  } catch (const Error& e) {
+    std::fprintf(stderr, "pvr-node: %s\n", e.what());
+    return 1;
+  }
+  comm::MpiEnvironment& mpi = *environment;
   comm::Communicator& world = mpi.world();
   char real[PATH_MAX];
   NodeState state(world, mpi.commands(), ::realpath(options.dataDir.c_str(), real) ? real : "");
   state.injectedFailures = options.injectedFailures;
   state.dumpDir = options.dumpFrames;
+  state.liveness = &mpi.liveness();
 
   std::unique_ptr<PvrdLink> link;
   if (world.rank() == 0) {
@@ -64,10 +77,36 @@ int runServer(const ServerOptions& options) {
     return 1;
   }
   state.hosts = gatherHostNames(world);
+  const WatchOptions watchOptions{options.stallSeconds};
   if (world.rank() != 0) {
+    RankWatch watch(*mpi.watch(), mpi.liveness(), watchOptions);
+    state.watch = &watch;
     serveSlave(state);
+    state.watch = nullptr;
     return 0;
   }
+
+  // The link thread answers while frames render; the watch thread stops
+  // the frames it cancels and ends the job when a rank stalls.
+  std::atomic<RankWatch*> watching{nullptr};
+  LinkThread linkThread(
+      std::move(link), [&](std::uint32_t id) { if (RankWatch* w = watching.load()) w->cancel(id); }, &mpi.liveness());
+  const auto stalled = [&](int rank, double seconds) {
+    char text[400];
+    std::snprintf(text, sizeof text, "rank %d on %s made no progress for %.0f s (stopped or hung); the job ends", rank,
+                  state.hosts[std::size_t(rank)].c_str(), std::floor(seconds));
+    std::fprintf(stderr, "pvr-node: %s\n", text);
+    std::fflush(stderr);
+    // The client hears why, then the link closes (pvrd ends the job); the
+    // job ends itself too, as the main thread may wait on that rank for ever.
+    linkThread.close(proto::ErrorMessage{proto::ErrorCode::kRankFailed, text});
+    linkThread.waitClosed(5);
+    mpi.commands().abortJob(1);
+  };
+  RankWatch watch(*mpi.watch(), mpi.liveness(), watchOptions, stalled);
+  state.watch = &watch;
+  watching = &watch;
+
   // The default layout (one render cluster of every rank) and the
   // compositing model's calibration; SessionOpen's layout follows.
   int status = 0;
@@ -78,9 +117,11 @@ int runServer(const ServerOptions& options) {
     std::fprintf(stderr, "pvr-node: %s\n", describeOnHost(*g, state.hosts).c_str());
     status = 1;
   } else {
-    Master(state, *link).serve();
+    Master(state, linkThread).serve();
   }
   invoke(state, actions::Shutdown{});
+  watching = nullptr;
+  state.watch = nullptr;
   return status;
 }
 

@@ -1,6 +1,7 @@
 #include "server_options.h"
 
 #include <charconv>
+#include <cmath>
 
 namespace pvr::node {
 
@@ -42,6 +43,15 @@ bool parseServerOptions(int argc, char** argv, ServerOptions& options, std::stri
       options.injectedFailures.emplace_back(v.substr(0, at), rank);
     } else if (a == "--dump-frames") {
       options.dumpFrames = v;
+    } else if (a == "--stall-timeout") {
+      double seconds = 0;
+      const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), seconds);
+      // Below a few heartbeats (one a second) every rank would look stalled.
+      if (ec != std::errc() || end != v.data() + v.size() || !std::isfinite(seconds) || seconds < 2 || seconds > 86400) {
+        error = "--stall-timeout takes seconds from 2 to 86400, not '" + v + "'";
+        return false;
+      }
+      options.stallSeconds = seconds;
     } else {
       error = "unknown option " + a;
       return false;

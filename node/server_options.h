@@ -17,10 +17,14 @@ struct ServerOptions {
   // Tests: the collector also writes every frame as linear premultiplied
   // float RGBA (frame-REQUEST-N.f32: i32 width, i32 height, pixels) here.
   std::string dumpFrames;
+  // A rank that makes no progress this long (four times as long while it
+  // reads data) is reported by number and host, and the job ends
+  // (rank_watch.h).
+  double stallSeconds = 30;
 };
 
 // Parses "--server --connect HOST:PORT --data-dir DIR [--fail-once STEP@RANK]...
-// [--dump-frames DIR]"; false and `error` on a bad command line.
+// [--dump-frames DIR] [--stall-timeout SECONDS]"; false and `error` on a bad command line.
 bool parseServerOptions(int argc, char** argv, ServerOptions& options, std::string& error);
 
 }  // namespace pvr::node

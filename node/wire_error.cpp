@@ -15,6 +15,7 @@ proto::ErrorCode wireCode(pvr::ErrorCode code) {
     case pvr::ErrorCode::kUnsupported: return ErrorCode::kUnsupported;
     case pvr::ErrorCode::kRemote: return ErrorCode::kRankFailed;
     case pvr::ErrorCode::kInternal: return ErrorCode::kInternal;
+    case pvr::ErrorCode::kCancelled: return ErrorCode::kCancelled;
   }
   return ErrorCode::kInternal;
 }

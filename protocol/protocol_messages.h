@@ -183,6 +183,19 @@ struct JobHello {
   bool operator==(const JobHello&) const = default;
 };
 
+// Master rank -> session handler, every kHeartbeatSeconds for the whole
+// session, request id 0: the master process runs. The master's own
+// watchdog sees its ranks stop (node/rank_watch.h), but nothing inside the
+// job sees rank 0 itself stopped; the handler does, by these frames
+// ceasing. Never relayed to a client.
+inline constexpr int kHeartbeatSeconds = 2;
+
+struct Heartbeat {
+  static constexpr WireInfo kWire{0x09, "Heartbeat", &Limits::maxControlPayload};
+  static auto fields(auto&) { return std::tie(); }
+  bool operator==(const Heartbeat&) const = default;
+};
+
 // ---- Session and scene ----
 
 // Client -> server: start the MPI job.
@@ -354,7 +367,7 @@ struct CatalogReply {
 // The message table: one line per message type. Order is free (wire type
 // numbers live in kWire); message_table.cpp checks they are unique.
 using Message = std::variant<
-    Hello, Welcome, AuthChallenge, AuthResponse, Ok, ErrorMessage, Close, JobHello,
+    Hello, Welcome, AuthChallenge, AuthResponse, Ok, ErrorMessage, Close, JobHello, Heartbeat,
     SessionOpen, SessionReady, SetScene, SetLayout,
     RenderFrame, RenderRotation, RenderTimeSteps, ImageFrame, Cancel,
     StatusRequest, StatusReply, PerformanceRequest, PerformanceReply, CatalogRequest, CatalogReply>;

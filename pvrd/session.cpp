@@ -331,6 +331,8 @@ void Session::onMaster(proto::RelayItem item) {
   if (frame.header.type == proto::Close::kWire.type) return jobEnded("the master closed the session");
   // A JobHello is for the handler alone; relayed, it would show a client the secret.
   if (frame.header.type == proto::JobHello::kWire.type) return log("dropped a second JobHello from the master");
+  // The master's sign of life is for the handler alone too.
+  if (frame.header.type == proto::Heartbeat::kWire.type) return;
   const std::uint32_t id = frame.header.requestId;
   const bool final = (frame.header.flags & proto::kFlagFinal) != 0;
   if (final && id == openRequest_) openRequest_ = 0;

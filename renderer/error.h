@@ -18,6 +18,7 @@ enum class ErrorCode : std::uint16_t {
   kUnsupported = 4,      // a valid request this build cannot serve
   kInternal = 5,         // a broken invariant; a bug
   kRemote = 6,           // an error raised on another rank or process
+  kCancelled = 7,        // the work was stopped on request (a client's Cancel)
 };
 
 class Error : public std::runtime_error {

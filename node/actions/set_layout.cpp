@@ -6,6 +6,8 @@
 namespace pvr::node::actions {
 
 void SetLayout::run(NodeState& state, const SetLayout& args) {
+  // The clusters re-read the data: the longer stall limit applies.
+  const comm::LivenessScope loading(state.liveness, comm::LivenessScope::Kind::kLoading);
   // The same pure function on every rank: the same layout or the same error.
   Layout layout = makeLayout(args.clusters, state.world.size());
   dropData(state);

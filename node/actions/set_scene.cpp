@@ -11,6 +11,8 @@
 namespace pvr::node::actions {
 
 void SetScene::run(NodeState& state, const SetScene& args) {
+  // Reading a volume may take minutes: the longer stall limit applies.
+  const comm::LivenessScope loading(state.liveness, comm::LivenessScope::Kind::kLoading);
   Reload reload = Reload::kNone;
   comm::runAgreed(state.world, [&] {
     const RuntimeSettings old = state.settings;

@@ -15,6 +15,7 @@
 
 #include "../cache_cluster.h"
 #include "../data.h"
+#include "../rank_watch.h"
 #include "../wave_collect.h"
 #include "../wave_composite.h"
 #include "table.h"
@@ -41,7 +42,11 @@ void renderMyFrame(NodeState& state, const Wave& args, std::optional<comm::Failu
   WaveFrame& w = state.wave[std::size_t(me.group)];
   const int width = state.scene.image.width, height = state.scene.image.height;
   try {
-    showStep(state, w.timestep);
+    {
+      // A step not held is read now: the longer stall limit applies.
+      const comm::LivenessScope loading(state.liveness, comm::LivenessScope::Kind::kLoading);
+      showStep(state, w.timestep);
+    }
     state.cache.readAhead(myUpcoming(args.upcoming, me.group, state.layout.groups));
     if (!state.current) throw Error(ErrorCode::kInvalidArgument, "no dataset: send SetScene with a dataset first");
     state.maybeFail("render");
@@ -50,8 +55,11 @@ void renderMyFrame(NodeState& state, const Wave& args, std::optional<comm::Failu
     // A cluster that shares the frame's scanlines with others casts only
     // the rays of its own band.
     const core::PixelRect band = bandRect(width, height, me.band, me.bands);
-    w.partial = state.current->renderer->render(camera, state.renderOptions, *state.pool, nullptr,
-                                       me.bands > 1 ? &band : nullptr);
+    // A Cancel stops the frame between tiles; each tile counts as progress.
+    core::RenderOptions options = state.renderOptions;
+    if (state.watch) options.stop = &state.watch->stop();
+    if (state.liveness) options.tilesDone = &state.liveness->progress;
+    w.partial = state.current->renderer->render(camera, options, *state.pool, nullptr, me.bands > 1 ? &band : nullptr);
     w.rend = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   } catch (...) {
     failure = comm::failureOf(std::current_exception(), state.world.rank());
@@ -74,6 +82,7 @@ void serveMyClusters(NodeState& state, const Wave& args) {
 }  // namespace
 
 void Wave::run(NodeState& state, const Wave& args) {
+  if (state.watch) state.watch->begin(args.request);
   state.wave.clear();
   for (const FrameView& f : args.frames) {
     WaveFrame w;
@@ -83,7 +92,10 @@ void Wave::run(NodeState& state, const Wave& args) {
     state.wave.push_back(std::move(w));
   }
   std::optional<comm::Failure> failure;
-  serveMyClusters(state, args);
+  {
+    const comm::LivenessScope loading(state.liveness, comm::LivenessScope::Kind::kLoading);
+    serveMyClusters(state, args);
+  }
   renderMyFrame(state, args, failure);
   compositeWave(state, failure);
   collectWave(state, args.request, args.lastFrame, failure);

@@ -11,6 +11,8 @@
 #include <climits>
 #include <cstdint>
 #include <cstdlib>
+#include <deque>
+#include <string>
 
 namespace pvr::comm {
 
@@ -27,9 +29,14 @@ void* sendPointer(std::span<const std::byte> data) {
   return const_cast<std::byte*>(data.data());  // MPI-3 takes const void*; keep it portable
 }
 
+// Every call that may block on another rank marks the rank as waiting, so
+// that its watchdog blames the rank waited for, not this one.
+using Waiting = LivenessScope;
+constexpr auto kWaits = LivenessScope::Kind::kWaiting;
+
 class MpiCommunicator final : public Communicator {
  public:
-  explicit MpiCommunicator(MPI_Comm comm) : comm_(comm) {
+  MpiCommunicator(MPI_Comm comm, Liveness* liveness) : comm_(comm), liveness_(liveness) {
     MPI_Comm_rank(comm_, &rank_);
     MPI_Comm_size(comm_, &size_);
   }
@@ -38,10 +45,12 @@ class MpiCommunicator final : public Communicator {
   int size() const override { return size_; }
 
   void send(int to, int tag, std::span<const std::byte> data) override {
+    const Waiting waiting(liveness_, kWaits);
     MPI_Send(sendPointer(data), countOf(data.size()), MPI_BYTE, to, tag, comm_);
   }
 
   Bytes receive(int from, int tag) override {
+    const Waiting waiting(liveness_, kWaits);
     // Probe first: the receiver does not know the length of a sparse image.
     MPI_Status status;
     MPI_Probe(from, tag, comm_, &status);
@@ -53,6 +62,7 @@ class MpiCommunicator final : public Communicator {
   }
 
   Bytes sendReceive(int to, std::span<const std::byte> data, int from, int tag) override {
+    const Waiting waiting(liveness_, kWaits);
     MPI_Request request;
     MPI_Isend(sendPointer(data), countOf(data.size()), MPI_BYTE, to, tag, comm_, &request);
     Bytes received = receive(from, tag);
@@ -62,6 +72,7 @@ class MpiCommunicator final : public Communicator {
 
   std::vector<Bytes> exchange(std::span<const Outgoing> sends, std::span<const int> from,
                               int tag) override {
+    const Waiting waiting(liveness_, kWaits);
     std::vector<MPI_Request> requests(sends.size());
     for (std::size_t i = 0; i < sends.size(); ++i)
       MPI_Isend(sendPointer(sends[i].data), countOf(sends[i].data.size()), MPI_BYTE, sends[i].to,
@@ -74,6 +85,7 @@ class MpiCommunicator final : public Communicator {
   }
 
   void broadcast(Bytes& data, int root) override {
+    const Waiting waiting(liveness_, kWaits);
     std::uint64_t length = data.size();
     MPI_Bcast(&length, 1, MPI_UINT64_T, root, comm_);
     data.resize(std::size_t(length));
@@ -81,6 +93,7 @@ class MpiCommunicator final : public Communicator {
   }
 
   std::vector<Bytes> allGather(std::span<const std::byte> mine) override {
+    const Waiting waiting(liveness_, kWaits);
     const int count = countOf(mine.size());
     std::vector<int> counts(static_cast<std::size_t>(size_)), offsets(static_cast<std::size_t>(size_));
     MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
@@ -101,17 +114,23 @@ class MpiCommunicator final : public Communicator {
   }
 
   void allReduceSum(std::span<std::uint64_t> values) override {
+    const Waiting waiting(liveness_, kWaits);
     MPI_Allreduce(MPI_IN_PLACE, values.data(), countOf(values.size()), MPI_UINT64_T, MPI_SUM, comm_);
   }
 
   void allReduceMax(std::span<double> values) override {
+    const Waiting waiting(liveness_, kWaits);
     MPI_Allreduce(MPI_IN_PLACE, values.data(), countOf(values.size()), MPI_DOUBLE, MPI_MAX, comm_);
   }
 
-  void barrier() override { MPI_Barrier(comm_); }
+  void barrier() override {
+    const Waiting waiting(liveness_, kWaits);
+    MPI_Barrier(comm_);
+  }
 
  private:
   MPI_Comm comm_;
+  Liveness* liveness_;
   int rank_ = 0, size_ = 1;
 };
 
@@ -131,10 +150,11 @@ void waitPolitely(MPI_Request& request) {
 // then its bytes.
 class MpiCommandChannel final : public CommandChannel {
  public:
-  MpiCommandChannel() { MPI_Comm_dup(MPI_COMM_WORLD, &comm_); }
+  explicit MpiCommandChannel(Liveness* liveness) : liveness_(liveness) { MPI_Comm_dup(MPI_COMM_WORLD, &comm_); }
   ~MpiCommandChannel() override { MPI_Comm_free(&comm_); }
 
   void post(std::span<const std::byte> command) override {
+    const Waiting waiting(liveness_, kWaits);
     std::uint64_t length = command.size();
     MPI_Request request;
     MPI_Ibcast(&length, 1, MPI_UINT64_T, 0, comm_, &request);
@@ -143,6 +163,7 @@ class MpiCommandChannel final : public CommandChannel {
   }
 
   Bytes await() override {
+    const Waiting waiting(liveness_, kWaits);
     std::uint64_t length = 0;
     MPI_Request request;
     MPI_Ibcast(&length, 1, MPI_UINT64_T, 0, comm_, &request);
@@ -159,19 +180,91 @@ class MpiCommandChannel final : public CommandChannel {
 
  private:
   MPI_Comm comm_;
+  Liveness* liveness_;
+};
+
+// Sends are MPI_Isend of a copy kept until MPI says it is done (a stopped
+// receiver leaves them pending; they are few and tiny); receiving is
+// MPI_Iprobe, then MPI_Recv of what the probe found.
+class MpiWatchChannel final : public WatchChannel {
+ public:
+  MpiWatchChannel() {
+    MPI_Comm_dup(MPI_COMM_WORLD, &comm_);
+    MPI_Comm_rank(comm_, &rank_);
+    MPI_Comm_size(comm_, &size_);
+  }
+  ~MpiWatchChannel() override {
+    for (auto& s : sending_) MPI_Request_free(&s.request);
+    MPI_Comm_free(&comm_);
+  }
+  int rank() const override { return rank_; }
+  int size() const override { return size_; }
+
+  void post(int to, std::span<const std::byte> message) override {
+    reap();
+    sending_.push_back({Bytes(message.begin(), message.end()), MPI_REQUEST_NULL});
+    Sending& s = sending_.back();
+    MPI_Isend(s.bytes.data(), countOf(s.bytes.size()), MPI_BYTE, to, kTag, comm_, &s.request);
+  }
+
+  std::optional<std::pair<int, Bytes>> take() override {
+    reap();
+    int arrived = 0;
+    MPI_Status status;
+    MPI_Iprobe(MPI_ANY_SOURCE, kTag, comm_, &arrived, &status);
+    if (!arrived) return std::nullopt;
+    int count = 0;
+    MPI_Get_count(&status, MPI_BYTE, &count);
+    Bytes bytes(static_cast<std::size_t>(count));
+    MPI_Recv(bytes.data(), count, MPI_BYTE, status.MPI_SOURCE, kTag, comm_, MPI_STATUS_IGNORE);
+    return std::pair{status.MPI_SOURCE, std::move(bytes)};
+  }
+
+ private:
+  static constexpr int kTag = 1;
+  struct Sending {
+    Bytes bytes;
+    MPI_Request request;
+  };
+  // Drops the sends MPI has finished with, oldest first.
+  void reap() {
+    while (!sending_.empty()) {
+      int done = 0;
+      MPI_Test(&sending_.front().request, &done, MPI_STATUS_IGNORE);
+      if (!done) return;
+      sending_.pop_front();
+    }
+  }
+
+  MPI_Comm comm_;
+  int rank_ = 0, size_ = 1;
+  std::deque<Sending> sending_;
 };
 
 }  // namespace
 
-MpiEnvironment::MpiEnvironment(int* argc, char*** argv) {
-  // Only the main thread calls MPI; render threads never do.
+MpiEnvironment::MpiEnvironment(int* argc, char*** argv, Threads threads) {
+  // kMainOnly: only the main thread calls MPI; render threads never do.
+  // kWatched: a watch thread calls MPI beside the main thread.
+  const int wanted = threads == Threads::kWatched ? MPI_THREAD_MULTIPLE : MPI_THREAD_FUNNELED;
   int provided = 0;
-  MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
-  world_ = std::make_unique<MpiCommunicator>(MPI_COMM_WORLD);
-  commands_ = std::make_unique<MpiCommandChannel>();
+  MPI_Init_thread(argc, argv, wanted, &provided);
+  if (provided < wanted) {
+    MPI_Finalize();
+    throw Error(ErrorCode::kUnsupported,
+                "this MPI library gives thread level " + std::to_string(provided) + ", below " +
+                    (threads == Threads::kWatched ? std::string("MPI_THREAD_MULTIPLE, which pvr-node --server needs "
+                                                               "for its watch thread (Open MPI: built with "
+                                                               "--enable-mpi-thread-multiple, the default since 3.0)")
+                                                   : std::string("MPI_THREAD_FUNNELED")));
+  }
+  world_ = std::make_unique<MpiCommunicator>(MPI_COMM_WORLD, &liveness_);
+  commands_ = std::make_unique<MpiCommandChannel>(&liveness_);
+  if (threads == Threads::kWatched) watch_ = std::make_unique<MpiWatchChannel>();
 }
 
 MpiEnvironment::~MpiEnvironment() {
+  watch_.reset();
   commands_.reset();
   world_.reset();
   MPI_Finalize();
@@ -180,5 +273,7 @@ MpiEnvironment::~MpiEnvironment() {
 Communicator& MpiEnvironment::world() { return *world_; }
 
 CommandChannel& MpiEnvironment::commands() { return *commands_; }
+
+WatchChannel* MpiEnvironment::watch() { return watch_.get(); }
 
 }  // namespace pvr::comm

@@ -132,7 +132,9 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   const int tilesX = (r.width() + kTileSize - 1) / kTileSize;
   const int tilesY = (r.height() + kTileSize - 1) / kTileSize;
   std::atomic<std::uint64_t> totalSamples{0}, totalRays{0};
+  const auto stopped = [&] { return options.stop && options.stop->load(std::memory_order_relaxed); };
   pool.parallelFor(std::size_t(tilesX) * tilesY, [&](std::size_t tile, int) {
+    if (stopped()) return;
     const int tx = int(tile % tilesX), ty = int(tile / tilesX);
     const int x0 = r.x0 + tx * kTileSize, y0 = r.y0 + ty * kTileSize;
     const int x1 = std::min(r.x1, x0 + kTileSize), y1 = std::min(r.y1, y0 + kTileSize);
@@ -165,7 +167,9 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
     }
     totalSamples += samples;
     totalRays += rays;
+    if (options.tilesDone) options.tilesDone->fetch_add(1, std::memory_order_relaxed);
   });
+  if (stopped()) throw Error(ErrorCode::kCancelled, "cancelled");
 
   if (stats) {
     stats->samples = totalSamples;

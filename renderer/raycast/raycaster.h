@@ -10,6 +10,7 @@
 // the samples cover the chord exactly (kernel.h, ChordEnds).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 
@@ -29,6 +30,13 @@ struct RenderOptions {
   bool preintegrated = false;
   bool skipEmpty = true;        // macrocell empty-space skipping
   ShadingSpec shading;
+  // Checked between tiles, never per sample: once it reads true, tiles not
+  // yet started are skipped and render() throws Error kCancelled, so a
+  // Cancel stops a long frame within one tile's time.
+  const std::atomic<bool>* stop = nullptr;
+  // Advanced by one per finished tile: a watchdog's sign that this rank
+  // makes progress (node/rank_watch.h).
+  std::atomic<std::uint64_t>* tilesDone = nullptr;
 };
 
 RenderOptions renderOptionsFor(const Scene& resolvedScene);

@@ -218,8 +218,18 @@ class Job {
     pollfd p{listen_, POLLIN, 0};
     return fd_ >= 0 || ::poll(&p, 1, seconds * 1000) == 1;
   }
-  // The next message from the master; nullopt when the connection ended.
+  // The next message from the master, Heartbeats dropped and counted as
+  // pvrd drops them; nullopt when the connection ended.
   std::optional<proto::Decoded> receive(int timeoutSeconds = 60) {
+    for (;;) {
+      auto d = receiveAny(timeoutSeconds);
+      if (!d || !std::holds_alternative<proto::Heartbeat>(d->message)) return d;
+      ++heartbeats_;
+    }
+  }
+  int heartbeats() const { return heartbeats_; }
+  // The next frame from the master, Heartbeats included.
+  std::optional<proto::Decoded> receiveAny(int timeoutSeconds = 60) {
     const auto until = Clock::now() + std::chrono::seconds(timeoutSeconds);
     for (;;) {
       if (auto d = decoder_.pop()) return d;
@@ -278,6 +288,7 @@ class Job {
   pid_t pid_ = -1;
   bool reaped_ = false;
   std::uint32_t id_ = 0;
+  int heartbeats_ = 0;
   proto::FrameDecoder decoder_;
   fs::path dumpDir_;
 };
@@ -826,4 +837,155 @@ TEST_CASE_METHOD(Fixture, "a rank killed mid-sequence: the handler side sees the
   for (int i = 0; i < 100 && std::any_of(ranks.begin(), ranks.end(), running); ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   for (pid_t r : ranks) CHECK_FALSE(running(r));
+}
+
+// ---- Liveness (issue 15, finding 8): the master answers while a frame
+// renders, Cancel stops the frame in progress, a stopped rank is named and
+// the job ends. Orderings are asserted, not times (bench/liveness measures
+// the latencies).
+
+namespace {
+
+// A frame that takes seconds on two ranks: a small step with early ray
+// termination off, so that every ray crosses the whole volume.
+const nlohmann::json kSlowPatch = nlohmann::json::parse(R"({
+  "image": {"width": 192, "height": 192},
+  "sampling": {"step": 0.004, "early_termination": 1}})");
+
+// Opens a session of `ranks` ranks on the phantom with kSlowPatch.
+void openSlowSession(Job& job, std::uint32_t ranks) {
+  job.send(proto::SessionOpen{ranks, {}, ""});
+  job.expect<proto::SessionReady>();
+  nlohmann::json scene = nlohmann::json::parse(kScene);
+  scene.merge_patch(kSlowPatch);
+  job.send(proto::SetScene{"phantom.json", scene.dump()});
+  job.expect<proto::Ok>();
+}
+
+bool processRuns(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string p, comm, state;
+  return bool(stat >> p >> comm >> state) && state != "Z";
+}
+
+// The job's ranks by world rank: mpirun's children, each told its rank in
+// its environment (OMPI_COMM_WORLD_RANK).
+std::map<int, pid_t> rankPids(const Job& job) {
+  std::map<int, pid_t> ranks;
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    std::ifstream stat(entry.path() / "stat");
+    std::string pid, comm, state;
+    pid_t ppid = 0;
+    if (!(stat >> pid >> comm >> state >> ppid) || ppid != job.pid()) continue;
+    std::ifstream environ(entry.path() / "environ", std::ios::binary);
+    const std::string env((std::istreambuf_iterator<char>(environ)), std::istreambuf_iterator<char>());
+    const std::string key = std::string("OMPI_COMM_WORLD_RANK=");
+    const auto at = env.find(std::string(1, '\0') + key);
+    if (at != std::string::npos) ranks[std::atoi(env.c_str() + at + 1 + key.size())] = std::stoi(pid);
+  }
+  return ranks;
+}
+
+}  // namespace
+
+TEST_CASE_METHOD(Fixture, "a StatusRequest sent during a long frame is answered before the frame") {
+  Job job(2);
+  openSlowSession(job, 2);
+  const auto render = job.send(proto::RenderFrame{});
+  const auto status = job.send(proto::StatusRequest{});
+  // The link thread answers from the session's snapshot; the frame follows.
+  auto first = job.receive();
+  REQUIRE(first);
+  CHECK(first->info.requestId == status);
+  CHECK(std::holds_alternative<proto::StatusReply>(first->message));
+  auto frame = job.receive(120);
+  REQUIRE(frame);
+  CHECK(frame->info.requestId == render);
+  CHECK(std::holds_alternative<proto::ImageFrame>(frame->message));
+  CHECK(job.close());
+}
+
+TEST_CASE_METHOD(Fixture, "Cancel stops the frame in progress with Error CANCELLED, and the next frame renders") {
+  Job job(2);
+  openSlowSession(job, 2);
+  // Two slow frames: once the first is here, the second renders.
+  const auto rotation = job.send(proto::RenderRotation{{0, 1, 0}, 0, 1, 2});
+  auto first = job.receive(120);
+  REQUIRE(first);
+  REQUIRE(std::holds_alternative<proto::ImageFrame>(first->message));
+  const auto cancel = job.send(proto::Cancel{rotation});
+  // The rotation ends with CANCELLED instead of its second frame.
+  std::optional<proto::ErrorMessage> ended;
+  bool ok = false;
+  while (!ended || !ok) {
+    auto d = job.receive(120);
+    REQUIRE(d);
+    if (d->info.requestId == cancel) {
+      CHECK(std::holds_alternative<proto::Ok>(d->message));
+      ok = true;
+    } else {
+      REQUIRE(d->info.requestId == rotation);
+      REQUIRE(std::holds_alternative<proto::ErrorMessage>(d->message));
+      ended = std::get<proto::ErrorMessage>(d->message);
+    }
+  }
+  CHECK(ended->code == proto::ErrorCode::kCancelled);
+  CHECK(ended->text == "cancelled after 1 frames");
+  // The session serves on: the next frame renders, and right.
+  const auto id = job.send(proto::RenderFrame{});
+  checkSequence(job, id, 1, 1, Reference(kSlowPatch));
+  CHECK(job.close());
+}
+
+TEST_CASE_METHOD(Fixture, "a rank stopped mid-frame is reported by number and host, and the job ends with nothing left running") {
+  Job job(2, {"--stall-timeout", "2"});
+  openSlowSession(job, 2);
+  const auto ranks = rankPids(job);
+  REQUIRE(ranks.size() == 2);
+  REQUIRE(ranks.count(1) == 1);
+  // Whatever happens, nothing stays stopped or running after the test.
+  struct Cleanup {
+    const std::map<int, pid_t>& ranks;
+    ~Cleanup() {
+      for (const auto& [rank, pid] : ranks)
+        if (processRuns(pid)) {
+          ::kill(pid, SIGCONT);
+          ::kill(pid, SIGKILL);
+        }
+    }
+  } cleanup{ranks};
+  const auto rotation = job.send(proto::RenderRotation{{0, 1, 0}, 0, 99, 100});
+  REQUIRE(::kill(ranks.at(1), SIGSTOP) == 0);
+  std::optional<proto::Decoded> d;
+  do d = job.receive(120);
+  while (d && std::holds_alternative<proto::ImageFrame>(d->message));
+  REQUIRE(d);
+  REQUIRE(std::holds_alternative<proto::ErrorMessage>(d->message));
+  const auto& e = std::get<proto::ErrorMessage>(d->message);
+  CHECK(d->info.requestId == rotation);
+  CHECK(e.code == proto::ErrorCode::kRankFailed);
+  CHECK_THAT(e.text, Catch::StartsWith("rank 1 on " + thisHost() + " made no progress for ") &&
+                         Catch::EndsWith("s (stopped or hung); the job ends"));
+  // Then the link closes and the whole job ends, the stopped rank too.
+  CHECK_FALSE(job.receive(60));
+  CHECK(job.reap(60));
+  for (int i = 0; i < 200 && processRuns(ranks.at(1)); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  for (const auto& [rank, pid] : ranks) CHECK_FALSE(processRuns(pid));
+}
+
+TEST_CASE_METHOD(Fixture, "the master sends Heartbeat frames to the handler, request id 0, for the whole session") {
+  Job job(2);
+  job.send(proto::SessionOpen{2, {}, ""});
+  job.expect<proto::SessionReady>();
+  // An idle session: the beats go on with nothing asked.
+  int heartbeats = job.heartbeats();
+  for (const int until = heartbeats + 3; heartbeats < until;) {
+    auto d = job.receiveAny(30);
+    REQUIRE(d);
+    REQUIRE(std::holds_alternative<proto::Heartbeat>(d->message));
+    CHECK(d->info.requestId == 0);
+    CHECK(d->info.final());
+    ++heartbeats;
+  }
+  CHECK(job.close());
 }

@@ -41,6 +41,7 @@ std::vector<Message> sampleMessages() {
       ErrorMessage{ErrorCode::kDatasetNotFound, "dataset \"brain.slc\" is not in the catalog"},
       Close{"client quit"},
       JobHello{"5f1e0c7a9b2d4e6f8a0b1c2d3e4f5a6b5f1e0c7a9b2d4e6f8a0b1c2d3e4f5a6b"},
+      Heartbeat{},
       SessionOpen{96, figure5Layout, "astro-42"},
       SessionReady{96, figure5Layout},
       SetScene{"brain.slc", R"({"image":{"width":512,"height":512}})"},
