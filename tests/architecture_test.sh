@@ -4,8 +4,8 @@
 #   - mpi.h in exactly one file, renderer/comm/mpi_communicator.cpp;
 #   - Tcl/Tk only in pvrsh/;
 #   - sockets only where a process talks TCP: pvrd/, pvrsh/, the node's
-#     bridge to pvrd (node/pvrd_link*), and the scaling bench, which plays
-#     the session handler;
+#     bridge to pvrd (node/pvrd_link*), and the scaling and liveness
+#     benches, which play the session handler;
 #   - renderer/ includes nothing of protocol/, node/, pvrd/ or pvrsh/, and
 #     protocol/ nothing of the others;
 #   - pvrsh/ and pvrd/ include nothing of renderer/ or node/;
@@ -37,8 +37,8 @@ headers_of() { (cd "$1" && find . -name '*.h' | sed 's|^\./||' | sort -u | sed '
 
 check "mpi.h only in renderer/comm/mpi_communicator.cpp" '#include *<mpi\.h>' '^renderer/comm/mpi_communicator\.cpp$'
 check "Tcl/Tk only in pvrsh/" '#include *<(tcl|tk)\.h>' '^pvrsh/'
-check "sockets only in pvrd/, pvrsh/, the node's link to pvrd and the scaling bench" \
-  '#include *<(sys/socket|netinet/in|netinet/tcp|arpa/inet|netdb)\.h>' '^(pvrd/|pvrsh/|node/pvrd_link|bench/scaling/)'
+check "sockets only in pvrd/, pvrsh/, the node's link to pvrd and the scaling and liveness benches" \
+  '#include *<(sys/socket|netinet/in|netinet/tcp|arpa/inet|netdb)\.h>' '^(pvrd/|pvrsh/|node/pvrd_link|bench/scaling/|bench/liveness/)'
 check "renderer/ includes nothing of protocol/ or node/" \
   "#include *\"($(headers_of protocol)|$(headers_of node))\"" '^$' renderer
 check "protocol/ includes nothing of renderer/ or node/" \
