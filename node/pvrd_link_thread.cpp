@@ -124,6 +124,11 @@ bool LinkThread::waitClosed(double seconds) {
   return changed_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return closed_.load(); });
 }
 
+bool LinkThread::renderAhead() const {
+  return rendering_ != 0 || currentIsRender_ ||
+         std::any_of(requests_.begin(), requests_.end(), [](const proto::Decoded& d) { return isRender(d.message); });
+}
+
 bool LinkThread::answersStatusAtOnce() const {
   // Only renders ahead of it: they change nothing a Status shows but the
   // frames, so it need not wait for them. Behind anything else it waits
@@ -176,7 +181,7 @@ void LinkThread::dispatch(proto::Decoded frame) {
   if (requests_.size() >= kMaxQueuedRequests) {
     pushOut(encodeFinal(proto::ErrorMessage{proto::ErrorCode::kLimitExceeded,
                                             "more than " + std::to_string(kMaxQueuedRequests) + " requests wait for the " +
-                                                (rendering_ ? "sequence" : "request") + " in progress; this one is dropped"},
+                                                (renderAhead() ? "sequence" : "request") + " in progress; this one is dropped"},
                         id));
     return;
   }

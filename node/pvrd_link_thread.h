@@ -82,6 +82,8 @@ class LinkThread {
   void wake();
   // On this thread, for each decoded request.
   void dispatch(proto::Decoded frame);
+  // A render runs or waits (mutex_ held).
+  bool renderAhead() const;
   // A Status now need not wait for the requests ahead of it (mutex_ held).
   bool answersStatusAtOnce() const;
   // Queues encoded plaintext for the thread (mutex_ held).
