@@ -367,9 +367,9 @@ struct CatalogReply {
 // The message table: one line per message type. Order is free (wire type
 // numbers live in kWire); message_table.cpp checks they are unique.
 using Message = std::variant<
-    Hello, Welcome, AuthChallenge, AuthResponse, Ok, ErrorMessage, Close, JobHello, Heartbeat,
+    Hello, Welcome, AuthChallenge, AuthResponse, Ok, ErrorMessage, Close, JobHello,
     SessionOpen, SessionReady, SetScene, SetLayout,
     RenderFrame, RenderRotation, RenderTimeSteps, ImageFrame, Cancel,
-    StatusRequest, StatusReply, PerformanceRequest, PerformanceReply, CatalogRequest, CatalogReply>;
+    StatusRequest, StatusReply, PerformanceRequest, PerformanceReply, CatalogRequest, CatalogReply, Heartbeat>;
 
 }  // namespace pvr::proto

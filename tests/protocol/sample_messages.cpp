@@ -41,7 +41,6 @@ std::vector<Message> sampleMessages() {
       ErrorMessage{ErrorCode::kDatasetNotFound, "dataset \"brain.slc\" is not in the catalog"},
       Close{"client quit"},
       JobHello{"5f1e0c7a9b2d4e6f8a0b1c2d3e4f5a6b5f1e0c7a9b2d4e6f8a0b1c2d3e4f5a6b"},
-      Heartbeat{},
       SessionOpen{96, figure5Layout, "astro-42"},
       SessionReady{96, figure5Layout},
       SetScene{"brain.slc", R"({"image":{"width":512,"height":512}})"},
@@ -57,6 +56,7 @@ std::vector<Message> sampleMessages() {
       PerformanceReply{PerformanceQuery::kMemory, R"({"clusters":[{"index":0,"bytes":16777216}]})"},
       CatalogRequest{},
       CatalogReply{{{"brain.slc", 1}, {"marschner_lobb", 1}, {"visible_human_256", 40}}},
+      Heartbeat{},
   };
   return samples;
 }
