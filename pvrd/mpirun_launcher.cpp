@@ -48,7 +48,7 @@ std::vector<std::string> mpirunCommand(const JobSpec& spec, const DaemonOptions&
   if (withHostfile && !options.hostfile.empty()) args.insert(args.end(), {"--hostfile", options.hostfile});
   // -x hands the variable to every rank, rank 0 included, wherever it runs.
   args.insert(args.end(), {"-x", proto::kJobSecretVariable, spec.nodePath, "--server", "--connect", spec.connect, "--data-dir",
-                           spec.dataDir});
+                           spec.dataDir, "--stall-timeout", std::to_string(options.stallTimeout)});
   return args;
 }
 

@@ -106,6 +106,12 @@ std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, 
       o.scancel = v;
     } else if (a == "--node") {
       o.node = v;
+    } else if (a == "--stall-timeout") {
+      // The node's range: below a few heartbeats every rank would look stalled.
+      if (!toInt(v, 2, 86400, o.stallTimeout)) {
+        error = "--stall-timeout takes seconds from 2 to 86400, not '" + v + "'";
+        return std::nullopt;
+      }
     } else if (a == "--idle-timeout" || a == "--frame-timeout" || a == "--handshake-timeout") {
       int s = 0;
       if (!toInt(v, 1, 1 << 30, s)) {

@@ -28,6 +28,7 @@ struct DaemonOptions {
   double idleTimeout = 600;     // seconds without a client frame
   double frameTimeout = 10;     // seconds to finish a frame once started
   double handshakeTimeout = 10; // seconds from accept to an authenticated Hello
+  int stallTimeout = 30;        // seconds a rank may make no progress (pvr-node --stall-timeout)
 };
 
 // The command line, for the usage message.
@@ -35,7 +36,7 @@ inline constexpr const char* kUsage =
     "pvrd --listen HOST:PORT --data-dir DIR [--hostfile F] [--advertise ADDR] [--launcher mpirun|slurm] "
     "[--partition P] [--time T] [--max-ranks N] [--max-sessions N] [--token-file F] [--mpirun PATH] "
     "[--max-unauthenticated N] [--max-connections N] [--salloc PATH] [--scancel PATH] [--node PATH] "
-    "[--idle-timeout S] [--frame-timeout S] [--handshake-timeout S]";
+    "[--idle-timeout S] [--frame-timeout S] [--handshake-timeout S] [--stall-timeout S]";
 
 // Parses argv[1..]; on a bad command line returns nullopt and sets `error`.
 std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, std::string& error);

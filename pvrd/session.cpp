@@ -105,6 +105,10 @@ class Session {
   std::unique_ptr<proto::SecureChannel> clientChannel_;
   int master_ = -1;
   std::unique_ptr<proto::SecureChannel> masterChannel_;  // with master_: every byte to and from it
+  // When the master last sent anything (its Heartbeat comes every 2 s,
+  // from a thread no work of its blocks): the job's ranks watch each other,
+  // but only the handler can see rank 0 itself stop.
+  double lastFromMaster_ = 0;
   std::unique_ptr<Launcher> launcher_;       // while a job runs
   std::unique_ptr<ConnectBack> connectBack_;  // until the master proved itself
   double masterDeadline_ = 0;                // 0: none (waiting in a batch queue)
@@ -125,6 +129,7 @@ class Session {
   std::deque<std::vector<std::uint8_t>> pendingToMaster_;
   std::size_t pendingBytes_ = 0;
   double launchedAt_ = 0;
+  std::string masterPeer_;  // "ADDR:PORT" of the master's connection
 };
 
 bool Session::sendClient(const proto::Message& m, std::uint32_t id, bool final) {
@@ -372,6 +377,8 @@ void Session::refuseMasterFrame(const proto::RefusedFrame& refused) {
 
 void Session::adoptMaster(ConnectBack::Master master, double now) {
   master_ = master.fd;
+  masterPeer_ = master.peer;
+  lastFromMaster_ = now;
   setNonBlocking(master_);
   masterChannel_ = std::move(master.channel);
   connectBack_.reset();
@@ -495,6 +502,8 @@ int Session::run() {
     const std::size_t mi = fds.size();
     if (master_ >= 0) {
       const bool take = toClient_.size() <= kClientBufferBytes;
+      // Not reading the master is our doing, not its silence.
+      if (!take) lastFromMaster_ = monotonicSeconds();
       fds.push_back({master_, short((take ? POLLIN : 0) | (toMaster_.empty() ? 0 : POLLOUT)), 0});
     }
     const std::size_t oi = fds.size();
@@ -628,7 +637,14 @@ int Session::run() {
         jobEnded("the master rank's connection closed");
         break;
       }
+      lastFromMaster_ = now;
       onMasterCiphertext(std::span(buf.data(), std::size_t(got)));
+    }
+    if (master_ >= 0 && !done_ && now - lastFromMaster_ > opt_.stallTimeout) {
+      const std::string host = masterPeer_.substr(0, masterPeer_.rfind(':'));
+      jobEnded("rank 0 on " + host + " sent nothing, not even its heartbeat, for " +
+               std::to_string(opt_.stallTimeout) + " s (stopped or hung); the job ends");
+      break;
     }
     if (launcher_ && !done_ && launcher_->exited()) jobEnded(launcher_->exitText());
     if (launcher_ && !done_ && master_ < 0 && masterDeadline_ > 0 && now > masterDeadline_)

@@ -2,7 +2,7 @@
 // findings 6 and 7): strangers have their own small limit and a short
 // handshake time and hold no session slot; a slot is taken at SessionOpen;
 // a master that stopped reading neither wedges the handler nor keeps it
-// from seeing its client leave.
+// from seeing its client leave; a master that stops altogether is seen.
 #include <catch2/catch.hpp>
 
 #include "daemon_harness.h"
@@ -114,4 +114,21 @@ TEST_CASE("a master that stopped reading neither wedges the handler nor hides it
   ::kill(master, SIGKILL);  // in case the job outlived the test
   CHECK(gone >= 0);
   CHECK(fileComesToHold(d.logFile, "session ended", 5));
+}
+
+TEST_CASE("a stopped master rank is reported by number and host after the stall timeout and its job ends") {
+  Daemon d(makeDataDir("stoppedmaster"), {"--stall-timeout", "2"}, {}, logPath("stoppedmaster"));
+  Client c(d.port);
+  c.hello();
+  c.openSession();
+  const pid_t master = masterRank(d.dataDir);
+  REQUIRE(master > 0);
+  REQUIRE(::kill(master, SIGSTOP) == 0);
+  const auto e = c.expectError(30);
+  CHECK(e.code == proto::ErrorCode::kRankFailed);
+  CHECK(e.text.find("rank 0 on 127.0.0.1 sent nothing, not even its heartbeat, for 2 s (stopped or hung)") !=
+        std::string::npos);
+  const double gone = secondsUntilJobGone(d.dataDir, 15);
+  ::kill(master, SIGKILL);
+  CHECK(gone >= 0);
 }

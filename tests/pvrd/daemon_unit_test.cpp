@@ -182,6 +182,9 @@ TEST_CASE("options parse listen address, limits and refuse a public bind without
   CHECK(o->maxConnections == 9);
   CHECK(o->handshakeTimeout == 2);
   CHECK_FALSE(parseOptions({"--data-dir", "/d", "--max-unauthenticated", "0"}, error));
+  CHECK(parseOptions({"--data-dir", "/d", "--stall-timeout", "5"}, error)->stallTimeout == 5);
+  CHECK_FALSE(parseOptions({"--data-dir", "/d", "--stall-timeout", "1"}, error));
+  CHECK(error == "--stall-timeout takes seconds from 2 to 86400, not '1'");
   CHECK_FALSE(parseOptions({"--listen", "0.0.0.0:7000", "--data-dir", "/d"}, error));
   CHECK(error.find("token") != std::string::npos);
   CHECK(parseOptions({"--listen", "0.0.0.0:7000", "--data-dir", "/d", "--token-file", "/t"}, error));

@@ -11,7 +11,9 @@
 // them (the fake master gives up with exit status 3 after 30 s); a
 // kTrialSilent connection stays open, saying nothing, while the others go
 // on. Like the real master, it talks inside the secure channel keyed by
-// PVR_JOB_SECRET (docs/protocol.md, "The secure channel").
+// PVR_JOB_SECRET (docs/protocol.md, "The secure channel"). Unlike the real
+// master it sends no Heartbeat: a test with it must end within pvrd's
+// --stall-timeout (30 s by default).
 #pragma once
 
 #include <cstdint>

@@ -30,10 +30,11 @@ TEST_CASE("mpirun command: ranks, hostfile, the secret exported by name, the con
   CHECK(mpirunCommand(spec(), o, true) ==
         Args{"mpirun", "--oversubscribe", "--bind-to", "none", "-np", "3", "--hostfile", "/etc/pvr/hosts", "-x",
              "PVR_JOB_SECRET", "/opt/pvr/pvr-node", "--server", "--connect", "10.213.7.10:40001", "--data-dir",
-             "/data"});
+             "/data", "--stall-timeout", "30"});
   CHECK(mpirunCommand(spec(), o, false) ==
         Args{"mpirun", "--oversubscribe", "--bind-to", "none", "-np", "3", "-x", "PVR_JOB_SECRET",
-             "/opt/pvr/pvr-node", "--server", "--connect", "10.213.7.10:40001", "--data-dir", "/data"});
+             "/opt/pvr/pvr-node", "--server", "--connect", "10.213.7.10:40001", "--data-dir", "/data",
+             "--stall-timeout", "30"});
 }
 
 TEST_CASE("salloc command: one word per option, then mpirun inside the allocation, and the secret never in argv") {
@@ -41,7 +42,7 @@ TEST_CASE("salloc command: one word per option, then mpirun inside the allocatio
   CHECK(sallocCommand(spec(), o) ==
         Args{"salloc", "--ntasks=3", "--job-name=pvr-100-7", "--kill-command=TERM", "mpirun", "--oversubscribe",
              "--bind-to", "none", "-np", "3", "-x", "PVR_JOB_SECRET", "/opt/pvr/pvr-node", "--server", "--connect",
-             "10.213.7.10:40001", "--data-dir", "/data"});
+             "10.213.7.10:40001", "--data-dir", "/data", "--stall-timeout", "30"});
   o.partition = "vis";
   o.time = "1:00:00";
   o.salloc = "/usr/local/bin/salloc";
