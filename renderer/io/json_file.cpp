@@ -17,10 +17,26 @@ nlohmann::json readJsonFile(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (!in) failAt(ErrorCode::kIo, path, "cannot read");
+  return parseJsonText(text.str(), path);
+}
+
+nlohmann::json parseJsonText(std::string_view text, const std::string& where) {
+  // The parser tells the depth of each object or array it starts (0 for
+  // the outermost): refuse the first one past the limit, before any
+  // deeper value is built.
+  using Event = nlohmann::json::parse_event_t;
+  const auto refuseDeep = [&where](int depth, Event event, nlohmann::json&) {
+    if ((event == Event::object_start || event == Event::array_start) && depth >= kMaxJsonDepth)
+      failAt(ErrorCode::kBadFile, where,
+             "nests objects and arrays deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    return true;
+  };
   try {
-    return nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::parse_error& e) {
-    failAt(ErrorCode::kBadFile, path, std::string("not valid JSON: ") + e.what());
+    return nlohmann::json::parse(text, refuseDeep);
+  } catch (const nlohmann::json::exception& e) {
+    // parse_error, and out_of_range for a number too large for a double
+    // ("1e400"), which is no parse_error.
+    failAt(ErrorCode::kBadFile, where, std::string("not valid JSON: ") + e.what());
   }
 }
 

@@ -7,7 +7,9 @@
 
 #include "brick.h"
 #include "error.h"
+#include "io/json_file.h"
 #include "scene.h"
+#include "test_files.h"
 
 using namespace pvr::core;
 using Catch::Contains;
@@ -45,4 +47,47 @@ TEST_CASE("a brick larger than the host's memory is refused before it is allocat
                              Contains("GiB of memory (use more ranks or hosts)"));
   }
   CHECK_THROWS_AS(Brick::forOverwrite(grid, ScalarType::kUInt8, all, all), pvr::Error);
+}
+
+// n arrays, one inside the other, as the value of a scene's "volume".
+static std::string sceneNestedArrays(int n) {
+  return "{\"volume\": " + std::string(std::size_t(n), '[') + std::string(std::size_t(n), ']') + "}";
+}
+
+TEST_CASE("a scene file nesting deeper than kMaxJsonDepth is refused before the stack overflows", "[scene][limits]") {
+  // Found by fuzz/scene_parser_fuzz.cpp: 100000 nested arrays (200 KB)
+  // crashed pvr-render with a stack overflow when the scene's error message
+  // printed the value (describeValue -> nlohmann's recursive dump).
+  const std::string dir = pvr::core::test::scratchDir("deep_scene");
+  const std::string path = dir + "/deep.json";
+  pvr::core::test::writeText(path, sceneNestedArrays(100000));
+  try {
+    loadSceneFile(path);
+    FAIL("a 100000-deep scene was accepted");
+  } catch (const pvr::Error& e) {
+    CHECK(e.code() == pvr::ErrorCode::kBadFile);
+    CHECK_THAT(e.what(), Contains(path + ": nests objects and arrays deeper than 64 levels"));
+  }
+  // The limit counts the document's own object: 64 levels pass the reader
+  // (and are refused by the scene parser for what they are), 65 do not.
+  CHECK_THROWS_WITH(parseScene(parseJsonText(sceneNestedArrays(63), "s.json"), ""),
+                    Contains("volume: must be an object"));
+  CHECK_THROWS_WITH(parseJsonText(sceneNestedArrays(64), "s.json"),
+                    Contains("s.json: nests objects and arrays deeper than 64 levels"));
+}
+
+TEST_CASE("a scene file with a number too large for a double is refused as invalid JSON", "[scene][limits]") {
+  // Found by fuzz/scene_parser_fuzz.cpp: nlohmann reports "1e400" as
+  // out_of_range, not parse_error, and it escaped readJsonFile as no
+  // pvr::Error (pvr-render ended with std::terminate).
+  const std::string dir = pvr::core::test::scratchDir("huge_number_scene");
+  const std::string path = dir + "/huge.json";
+  pvr::core::test::writeText(path, R"({"volume": {"procedural": "constant-slab"}, "sampling": {"step": 1e400}})");
+  try {
+    loadSceneFile(path);
+    FAIL("a scene with 1e400 was accepted");
+  } catch (const pvr::Error& e) {
+    CHECK(e.code() == pvr::ErrorCode::kBadFile);
+    CHECK_THAT(e.what(), Contains(path + ": not valid JSON: ") && Contains("number overflow parsing '1e400'"));
+  }
 }
