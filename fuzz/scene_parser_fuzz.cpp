@@ -17,6 +17,7 @@
 // file that does not exist before parsing (the refusal path is what a
 // missing preset exercises); inline presets ("paraview") are parsed as
 // they are. Any broken property aborts; the sanitizers report the rest.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
