@@ -3,7 +3,8 @@
 // The input is the text of a scene document, read as pvr-render reads a
 // scene file (readJsonFile's rules: parseJsonText) and then parsed by
 // parseScene. For any input:
-//   - every refusal is a pvr::Error with a message; any other exception
+//   - every refusal is a pvr::Error with a message of printable text (no
+//     control bytes: a key "\u0000" once made an empty message); any other exception
 //     (nlohmann's type_error, std::out_of_range, bad_alloc) escapes and
 //     libFuzzer reports it as a crash;
 //   - a scene that parses prints (sceneToJson) to a document that parses
@@ -46,6 +47,15 @@ void require(bool condition, const char* what) {
   }
 }
 
+// A refusal's message: not empty, and no control byte below 0x20 in it (a
+// NUL would cut it short, an escape sequence would reach a terminal or a log).
+void requireMessage(const pvr::Error& e, const char* what) {
+  const std::string_view message = e.what();
+  require(!message.empty(), what);
+  for (const char c : message)
+    require(static_cast<unsigned char>(c) >= 0x20, "a refusal's message holds a control byte");
+}
+
 // Points every string "paraview_preset" where the parser looks for one
 // (the scene's transfer_function and each volumes[i].transfer_function)
 // at a missing file beside the scene, so no input makes the target read
@@ -82,7 +92,7 @@ void checkDefaults(pvr::core::Scene scene) {
   try {
     pvr::core::resolveDefaults(scene, grid);
   } catch (const pvr::Error& e) {
-    require(*e.what() != '\0', "resolveDefaults refused without a message");
+    requireMessage(e, "resolveDefaults refused without a message");
     return;
   }
   require(!scene.camera.automatic, "the camera is still automatic after resolveDefaults");
@@ -103,7 +113,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     doc = pvr::core::parseJsonText(text, "scene.json");
   } catch (const pvr::Error& e) {
-    require(*e.what() != '\0', "a JSON refusal without a message");
+    requireMessage(e, "a JSON refusal without a message");
     return 0;
   }
   defusePresetFiles(doc);
@@ -113,7 +123,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     scene = pvr::core::parseScene(doc, kBaseDir);
   } catch (const pvr::Error& e) {
-    require(*e.what() != '\0', "a scene refusal without a message");
+    requireMessage(e, "a scene refusal without a message");
     return 0;
   }
   require(!scene.volumes.empty(), "a scene without volumes");

@@ -8,8 +8,22 @@
 
 namespace pvr::core::scene_json {
 
+namespace {
+
+// `text` with every control byte (below 0x20, and DEL) shown as '?'. Keys
+// and names come from the document as they are: a NUL would cut the message
+// short where it is read as a C string (what(), the wire's error text), and
+// an escape sequence would reach the user's terminal or pvrd's log.
+std::string maskControlBytes(std::string text) {
+  for (char& c : text)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return text;
+}
+
+}  // namespace
+
 void fail(const std::string& path, const std::string& what) {
-  throw Error(ErrorCode::kInvalidArgument, path.empty() ? what : path + ": " + what);
+  throw Error(ErrorCode::kInvalidArgument, maskControlBytes(path.empty() ? what : path + ": " + what));
 }
 
 std::string childPath(const std::string& path, const std::string& key) {

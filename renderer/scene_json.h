@@ -19,6 +19,8 @@ namespace pvr::core::scene_json {
 
 using nlohmann::json;
 
+// Throws the error "path: what", its control bytes masked as '?' (keys and
+// names are quoted from the document as they are).
 [[noreturn]] void fail(const std::string& path, const std::string& what);
 
 // Key paths: childPath("camera", "eye") = "camera.eye", childPath("", "x") = "x",

@@ -91,3 +91,23 @@ TEST_CASE("a scene file with a number too large for a double is refused as inval
     CHECK_THAT(e.what(), Contains(path + ": not valid JSON: ") && Contains("number overflow parsing '1e400'"));
   }
 }
+
+TEST_CASE("a scene error quoting a key or name masks its control bytes", "[scene][limits]") {
+  // Found by fuzz/scene_parser_fuzz.cpp: the key "\u0000" made the message
+  // "\0: unknown key ...", empty where it is read as a C string (what(), the
+  // wire's error text); an escape sequence in a key or a procedural name went
+  // raw to the terminal or log that shows the message.
+  const auto messageOf = [](const nlohmann::json& doc) -> std::string {
+    try {
+      parseScene(doc, "");
+    } catch (const pvr::Error& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  CHECK(messageOf({{std::string("\0", 1), 1}}) ==
+        "?: unknown key (known: volume, volumes, timestep, transfer_function, parameters, camera, image, sampling, "
+        "shading)");
+  CHECK_THAT(messageOf({{"volume", {{"procedural", "\x1b[2J"}}}}),
+             Contains("volume.procedural: unknown procedural volume '?[2J' (known: "));
+}
