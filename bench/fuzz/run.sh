@@ -2,10 +2,12 @@
 # Fuzzing at length: every fuzz target (fuzz/run_fuzz.sh's list) for
 # 10 M executions, one after another, from its seed corpus; a table of
 # executions, seconds, exec/s, corpus size and findings into
-# bench/results/fuzz/ (fuzz.txt for people, fuzz.csv for tools), and
-# run_fuzz.sh's output (a failing run's last log lines too) in run.log. A finding is a crashing input (kept under
-# BUILD_DIR/artifacts/NAME/); the table is written either way and the
-# script exits non-zero. About 10-40 minutes per target on 2 cores.
+# bench/results/fuzz/: fuzz.csv (one row per target, with the date and
+# commit of its run; a run replaces the rows of the targets it ran and keeps
+# the others), fuzz.txt (the same for people) and run.log (run_fuzz.sh's
+# output, a failing run's last log lines too, appended). A finding is a
+# crashing input, kept under BUILD_DIR/artifacts/NAME/; the table is written
+# either way and the script exits non-zero. 10-30 minutes per target on 2 cores.
 #
 #   bench/fuzz/run.sh [NAME...]      (default: every target in the tree)
 # Environment: PVR_FUZZ_RUNS (default 10000000), PVR_FUZZ_BUILD_DIR.
@@ -15,25 +17,42 @@ root=$(cd "$here/../.." && pwd)
 out=$root/bench/results/fuzz
 runs=${PVR_FUZZ_RUNS:-10000000}
 mkdir -p "$out"
+csv=$out/fuzz.csv
+header="date,commit,target,executions,seconds,exec_per_s,seed_inputs,corpus_inputs,findings"
 
+lines=$(mktemp)
+trap 'rm -f "$lines"' EXIT
 status=0
-PVR_FUZZ_RUNS=$runs "$root/fuzz/run_fuzz.sh" 1 "$@" 2>&1 | tee "$out/run.log" || status=$?
+echo "# $(date -u +%Y-%m-%dT%H:%MZ) bench/fuzz/run.sh $*: -runs=$runs" >"$lines"
+PVR_FUZZ_RUNS=$runs "$root/fuzz/run_fuzz.sh" 1 "$@" >>"$lines" 2>&1 || status=$?
+cat "$lines"
+cat "$lines" >>"$out/run.log"
 
-# The table, from run_fuzz.sh's line per target:
+# New rows from run_fuzz.sh's line per target:
 #   fuzz NAME: executions E, seconds S, exec/s R, corpus A -> B, findings F
+stamp="$(date -u +%Y-%m-%dT%H:%MZ),$(git -C "$root" rev-parse --short HEAD)"
+new=$(sed -nE "s/^fuzz ([a-z_]+): executions ([0-9]+), seconds ([0-9.]+), exec\/s ([0-9]+), corpus ([0-9]+) -> ([0-9]+), findings ([0-9]+)$/$stamp,\1,\2,\3,\4,\5,\6,\7/p" "$lines")
+ran=$(printf '%s\n' "$new" | cut -d, -f3)
 {
-  echo "# $(date -u +%Y-%m-%dT%H:%MZ), $(nproc) cores, $(clang --version | head -1), commit $(git -C "$root" rev-parse --short HEAD)"
-  echo "# libFuzzer with ASan and UBSan, -runs=$runs, -max_len=8192, from fuzz/corpus/NAME/ with fuzz/NAME.dict"
-  printf '%-10s %12s %10s %10s %14s %9s\n' target executions seconds exec/s corpus findings
-  sed -nE 's/^fuzz ([a-z_]+): executions ([0-9]+), seconds ([0-9.]+), exec\/s ([0-9]+), corpus ([0-9]+) -> ([0-9]+), findings ([0-9]+)$/\1 \2 \3 \4 \5 \6 \7/p' "$out/run.log" |
-    while read -r name e s r a b f; do
-      printf '%-10s %12s %10s %10s %14s %9s\n' "$name" "$e" "$s" "$r" "$a -> $b" "$f"
+  echo "$header"
+  if [[ -f $csv ]]; then
+    tail -n +2 "$csv" | while IFS= read -r row; do
+      printf '%s\n' "$ran" | grep -qx "$(cut -d, -f3 <<<"$row")" || printf '%s\n' "$row"
     done
-} >"$out/fuzz.txt"
+  fi
+  [[ -n $new ]] && printf '%s\n' "$new"
+} >"$csv.new"
+mv "$csv.new" "$csv"
+
 {
-  echo "target,executions,seconds,exec_per_s,seed_inputs,corpus_inputs,findings"
-  sed -nE 's/^fuzz ([a-z_]+): executions ([0-9]+), seconds ([0-9.]+), exec\/s ([0-9]+), corpus ([0-9]+) -> ([0-9]+), findings ([0-9]+)$/\1,\2,\3,\4,\5,\6,\7/p' "$out/run.log"
-} >"$out/fuzz.csv"
+  echo "# fuzz targets, $(nproc) cores shared with other builds, $(clang --version | head -1)"
+  echo "# libFuzzer with ASan and UBSan, -runs=$runs, -max_len=8192, from fuzz/corpus/NAME/ with fuzz/NAME.dict"
+  echo "# corpus: seed inputs -> inputs after the run; findings: crashing inputs (0 = none)"
+  printf '%-10s %12s %10s %10s %14s %9s  %s\n' target executions seconds exec/s corpus findings "run (UTC, commit)"
+  tail -n +2 "$csv" | while IFS=, read -r date commit name e s r a b f; do
+    printf '%-10s %12s %10s %10s %14s %9s  %s\n' "$name" "$e" "$s" "$r" "$a -> $b" "$f" "$date $commit"
+  done
+} >"$out/fuzz.txt"
 cat "$out/fuzz.txt"
 echo "wrote $out/fuzz.txt, fuzz.csv and run.log"
 exit "$status"
