@@ -54,13 +54,37 @@ std::string names(const Table& table, const char* separator) {
   return out;
 }
 
+// The command line and every option, one line each: --help prints it,
+// a bad batch command line prints it to stderr, man/pvr-node.1 follows it.
 std::string usage() {
-  return "usage: mpirun -np N pvr-node --server --connect HOST:PORT --data-dir DIR\n"
-         "       mpirun -np N pvr-node --batch SCENE.json -o OUT.exr|OUT.png\n"
-         "       [--strategy " + names(composite::strategies(), "|") + "] [--radix K]\n"
-         "       [--decomposition " + names(node::decompositions(), "|") + "] [--early-termination A]\n"
-         "       [--threads N] [--codec auto|rle|rle-zlib|raw] [--size WxH] [--stats FILE.csv]\n"
-         "       pvr-node --catalog DIR\n";
+  return "usage: mpirun -np N pvr-node --batch SCENE.json -o OUT.exr|OUT.png [OPTION VALUE ...]\n"
+         "       mpirun -np N pvr-node --server --connect HOST:PORT --data-dir DIR\n"
+         "       pvr-node --catalog DIR\n"
+         "\n"
+         "The MPI program of PVR: pvrd starts it in server mode for a session; batch mode renders\n"
+         "one scene across the ranks and prints the time breakdown; catalog mode lists a data directory.\n"
+         "\n"
+         "batch options:\n"
+         "  --batch SCENE.json         the scene to render (docs/scene.md); required\n"
+         "  -o OUT.exr|OUT.png         the image to write (EXR: linear float; PNG: sRGB); required\n"
+         "  --strategy NAME            compositing: " + names(composite::strategies(), ", ") + "\n"
+         "  --radix K                  radix of the radix-k strategy\n"
+         "  --decomposition NAME       bricks: " + names(node::decompositions(), ", ") + "\n"
+         "  --early-termination A      stop a ray at opacity A in (0, 1]\n"
+         "  --threads N                render threads per rank (default: all cores)\n"
+         "  --codec auto|rle|rle-zlib|raw  image codec between ranks (default auto)\n"
+         "  --size WxH                 image size (default: the scene's)\n"
+         "  --stats FILE.csv           also write the per-rank times as CSV\n"
+         "server options (pvrd passes them):\n"
+         "  --server                   serve one pvrd session\n"
+         "  --connect HOST:PORT        the session handler to connect to\n"
+         "  --data-dir DIR             the data directory datasets resolve in\n"
+         "catalog:\n"
+         "  --catalog DIR              print the datasets of DIR, one per line, and exit\n"
+         "  -h, --help                 print this help and exit\n"
+         "\n"
+         "example:\n"
+         "  mpirun -np 4 pvr-node --batch examples/scenes/ct_head_bone.json -o head.png --strategy binary-swap\n";
 }
 
 [[noreturn]] void bad(const std::string& why) { throw Error(ErrorCode::kInvalidArgument, why); }
@@ -160,6 +184,12 @@ int run(const Args& args, const std::vector<std::string>& hosts, comm::Communica
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Help before MPI starts: `pvr-node --help` works without mpirun.
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::fputs(usage().c_str(), stdout);
+      return 0;
+    }
   if (argc == 3 && std::string(argv[1]) == "--catalog") return node::printCatalog(argv[2], stdout, stderr);
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) != "--server") continue;

@@ -48,6 +48,12 @@ bool isLoopback(const std::string& host) {
 
 std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, std::string& error) {
   DaemonOptions o;
+  // Help wins over everything else on the line, right or wrong.
+  for (const std::string& a : args)
+    if (a == "-h" || a == "--help") {
+      o.help = true;
+      return o;
+    }
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (i + 1 >= args.size()) {

@@ -29,14 +29,43 @@ struct DaemonOptions {
   double frameTimeout = 10;     // seconds to finish a frame once started
   double handshakeTimeout = 10; // seconds from accept to an authenticated Hello
   int stallTimeout = 30;        // seconds a rank may make no progress (pvr-node --stall-timeout)
+  bool help = false;            // -h or --help: print kUsage, nothing else
 };
 
-// The command line, for the usage message.
+// The command line and every option, one line each: `pvrd --help` prints
+// it, a bad command line prints its first line, and man/pvrd.1 follows it.
+// Keep it beside parseOptions: an option added there is added here.
 inline constexpr const char* kUsage =
-    "pvrd --listen HOST:PORT --data-dir DIR [--hostfile F] [--advertise ADDR] [--launcher mpirun|slurm] "
-    "[--partition P] [--time T] [--max-ranks N] [--max-sessions N] [--token-file F] [--mpirun PATH] "
-    "[--max-unauthenticated N] [--max-connections N] [--salloc PATH] [--scancel PATH] [--node PATH] "
-    "[--idle-timeout S] [--frame-timeout S] [--handshake-timeout S] [--stall-timeout S]";
+    "usage: pvrd --listen HOST:PORT --data-dir DIR [OPTION VALUE ...]\n"
+    "\n"
+    "Serves pvrsh sessions: each connection gets a handler that starts an MPI job of pvr-node.\n"
+    "\n"
+    "options:\n"
+    "  --listen HOST:PORT         address to listen on (port 0: any free port); required\n"
+    "  --data-dir DIR             the datasets a session may load (its catalog); required\n"
+    "  --hostfile F               Open MPI hostfile passed to mpirun (launcher mpirun)\n"
+    "  --advertise ADDR           numeric IPv4 address the ranks connect back to\n"
+    "  --launcher mpirun|slurm    how a job starts (default mpirun)\n"
+    "  --partition P              slurm: salloc --partition\n"
+    "  --time T                   slurm: salloc --time\n"
+    "  --max-ranks N              most ranks one session may ask for (default 4)\n"
+    "  --max-sessions N           sessions with a job at once (default 4)\n"
+    "  --max-unauthenticated N    connections still in their handshake (default 8)\n"
+    "  --max-connections N        handler processes in all (default 64)\n"
+    "  --token-file F             shared secret; required to listen on a non-loopback address\n"
+    "  --mpirun PATH              the mpirun to run (default mpirun)\n"
+    "  --salloc PATH              the salloc to run (default salloc)\n"
+    "  --scancel PATH             the scancel to run (default scancel)\n"
+    "  --node PATH                the pvr-node executable (default: the one next to pvrd)\n"
+    "  --idle-timeout S           seconds without a client message before a session ends (default 600)\n"
+    "  --frame-timeout S          seconds to finish a frame once started (default 10)\n"
+    "  --handshake-timeout S      seconds from accept to an authenticated hello (default 10)\n"
+    "  --stall-timeout S          seconds a rank may make no progress before the job ends (default 30)\n"
+    "  -h, --help                 print this help and exit\n"
+    "\n"
+    "example:\n"
+    "  pvrd --listen 127.0.0.1:7350 --data-dir /data/volumes --max-ranks 4\n"
+    "  pvrsh -nogui  (then: pvr_session :s; :s open 127.0.0.1:7350 -ranks 2)\n";
 
 // Parses argv[1..]; on a bad command line returns nullopt and sets `error`.
 std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, std::string& error);

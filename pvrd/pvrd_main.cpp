@@ -91,8 +91,14 @@ int main(int argc, char** argv) {
   std::string error;
   const auto options = parseOptions(std::vector<std::string>(argv + 1, argv + argc), error);
   if (!options) {
-    std::fprintf(stderr, "pvrd: %s\nusage: %s\n", error.c_str(), kUsage);
+    const std::string usage(kUsage);
+    std::fprintf(stderr, "pvrd: %s\n%s(pvrd --help lists every option)\n", error.c_str(),
+                 usage.substr(0, usage.find('\n') + 1).c_str());
     return 2;
+  }
+  if (options->help) {
+    std::fputs(kUsage, stdout);
+    return 0;
   }
   SessionConfig config;
   config.options = &*options;

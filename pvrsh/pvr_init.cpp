@@ -5,6 +5,7 @@
 #include <string>
 
 #include "session.h"
+#include "session_help.h"
 
 namespace pvr::tcl {
 namespace {
@@ -12,7 +13,20 @@ namespace {
 // pvr_session NAME: creates the object command NAME (":brain") for a new,
 // closed session. Results: NAME. Side effects: a new command; an existing
 // command of that name is an error, not replaced.
+// pvr_session help ?SUBCOMMAND?: the session objects' help (session_help.h)
+// as the result; "help" is therefore not a session name.
 int sessionCreateCmd(ClientData, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if ((objc == 2 || objc == 3) && std::string(Tcl_GetString(objv[1])) == "help") {
+    try {
+      const std::string text =
+          (objc == 2 ? "pvr_session NAME\n    make the session object NAME (e.g. :s), closed\n" : "") +
+          subcommandHelp("NAME", objc == 3 ? Tcl_GetString(objv[2]) : "");
+      Tcl_SetObjResult(interp, Tcl_NewStringObj(text.c_str(), int(text.size()) - 1));
+      return TCL_OK;
+    } catch (const TclError& e) {
+      return setError(interp, e);
+    }
+  }
   if (objc != 2) {
     Tcl_WrongNumArgs(interp, 1, objv, "name");
     Tcl_SetErrorCode(interp, "PVR", "ARGS", "WRONGNUM", nullptr);

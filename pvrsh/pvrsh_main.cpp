@@ -17,6 +17,29 @@ namespace {
 
 bool gRunsScript = false;
 
+// `pvrsh --help`; the session commands' own help is `pvr_session help`.
+constexpr const char* kUsage =
+    "usage: pvrsh ?-nogui? ?script.tcl ?arg ...??\n"
+    "\n"
+    "A Tcl/Tk shell with package pvr loaded: pvr_session makes session objects that drive a pvrd\n"
+    "server. With a display it is a Tk shell, otherwise a Tcl shell. With a script it runs the\n"
+    "script (argv holds the args) with progress lines and timing tables on stderr, and exits 1\n"
+    "on an error; without one it reads commands.\n"
+    "\n"
+    "options:\n"
+    "  -nogui       a Tcl shell even with a display\n"
+    "  -h, --help   print this help and exit\n"
+    "\n"
+    "in the shell:\n"
+    "  pvr_session help ?subcommand?   every session subcommand, or one (set: every option)\n"
+    "\n"
+    "example:\n"
+    "  pvrsh -nogui\n"
+    "  % pvr_session :s\n"
+    "  % :s open 127.0.0.1:7350 -ranks 2\n"
+    "  % :s set -dataset ct_head_cranium/ct_head_cranium.json -imagesz 512,512\n"
+    "  % :s image file head.png; :s render frame; :s wait\n";
+
 // Finds package pvr next to the executable (installed: PREFIX/bin/../lib),
 // in the build tree, or on the usual auto_path, then loads it.
 int loadPvr(Tcl_Interp* interp) {
@@ -58,7 +81,7 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "-nogui") == 0) {
       gui = false;
     } else if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
-      std::printf("usage: pvrsh ?-nogui? ?script.tcl ?arg ...??\n");
+      std::fputs(kUsage, stdout);
       return 0;
     } else {
       break;

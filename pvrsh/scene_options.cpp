@@ -186,40 +186,51 @@ void setTimestep(Apply& a) { a.scene({{"timestep", parseInteger(a.option, a.valu
 // (docs/runtime.md); the server checks the upper bound.
 void setCacheMemory(Apply& a) { a.scene({{"runtime", {{"cachemem", parseInteger(a.option, a.value, 0, INT32_MAX)}}}}); }
 
+// One row per option. `value` and `byDefault` are what `:s help set` and
+// `:s set` (no arguments) show: the value's form, and what is in force
+// while the option was never given. A row without them is a bug that
+// tests/pvrsh/help.test catches.
 struct OptionRow {
   const char* name;  // first field: Tcl_GetIndexFromObjStruct reads it
   void (*apply)(Apply&);
+  const char* value = nullptr;      // "W,H"
+  const char* byDefault = nullptr;  // "512,512"
 };
 
 const OptionRow kOptions[] = {
-    {"-dataset", setDataset},
-    {"-cluster", nullptr},  // with -group: handled in applyOptions
-    {"-group", nullptr},
-    {"-imagesz", setImageSize},
-    {"-background", setBackground},
-    {"-tf", setTransferPoints},
-    {"-tfpreset", setTransferPreset},
-    {"-unitdist", [](Apply& a) { setScalar(a, "transfer_function", "unit_distance", a.positive()); }},
-    {"-camera", setCamera},
-    {"-eye", [](Apply& a) { a.scene({{"camera", {{"eye", a.vec3()}}}}); }},
-    {"-lookat", [](Apply& a) { a.scene({{"camera", {{"look_at", a.vec3()}}}}); }},
-    {"-up", [](Apply& a) { a.scene({{"camera", {{"up", a.vec3()}}}}); }},
-    {"-fov", [](Apply& a) { setScalar(a, "camera", "fov_y_deg", a.positive()); }},
-    {"-viewheight", [](Apply& a) { setScalar(a, "camera", "height", a.positive()); }},
-    {"-projection", setProjection},
-    {"-step", [](Apply& a) { setScalar(a, "sampling", "step", a.positive()); }},
-    {"-preintegrated", [](Apply& a) { a.scene({{"sampling", {{"preintegrated", parseBoolean(a.option, a.value)}}}}); }},
-    {"-earlyterm", [](Apply& a) { setScalar(a, "sampling", "early_termination", a.positive()); }},
-    {"-shading", [](Apply& a) { a.scene({{"shading", {{"enabled", parseBoolean(a.option, a.value)}}}}); }},
-    {"-ambient", [](Apply& a) { setScalar(a, "shading", "ambient", a.number()); }},
-    {"-diffuse", [](Apply& a) { setScalar(a, "shading", "diffuse", a.number()); }},
-    {"-specular", [](Apply& a) { setScalar(a, "shading", "specular", a.number()); }},
-    {"-shininess", [](Apply& a) { setScalar(a, "shading", "shininess", a.positive()); }},
-    {"-light", [](Apply& a) { a.scene({{"shading", {{"light_direction", a.vec3()}}}}); }},
-    {"-strategy", [](Apply& a) { setRuntimeName(a, "strategy", "strategies"); }},
-    {"-decomposition", [](Apply& a) { setRuntimeName(a, "decomposition", "decompositions"); }},
-    {"-timestep", setTimestep},
-    {"-cachemem", setCacheMemory},
+    {"-dataset", setDataset, "NAME", "none (see list datasets)"},
+    {"-cluster", nullptr, "ROLE?,N?", "the master's layout"},  // with -group: handled in applyOptions
+    {"-group", nullptr, "G,G,...", "0"},
+    {"-imagesz", setImageSize, "W,H", "512,512"},
+    {"-background", setBackground, "R,G,B?,A?", "0,0,0,1"},
+    {"-tf", setTransferPoints, "{S R G B A ...}", "a white ramp over [0, 1]"},
+    {"-tfpreset", setTransferPreset, "FILE", "none"},
+    {"-unitdist", [](Apply& a) { setScalar(a, "transfer_function", "unit_distance", a.positive()); }, "D",
+     "one voxel (the smallest spacing)"},
+    {"-camera", setCamera, "auto", "auto"},
+    {"-eye", [](Apply& a) { a.scene({{"camera", {{"eye", a.vec3()}}}}); }, "X,Y,Z", "automatic"},
+    {"-lookat", [](Apply& a) { a.scene({{"camera", {{"look_at", a.vec3()}}}}); }, "X,Y,Z",
+     "automatic: the domain's centre"},
+    {"-up", [](Apply& a) { a.scene({{"camera", {{"up", a.vec3()}}}}); }, "X,Y,Z", "0,0,1"},
+    {"-fov", [](Apply& a) { setScalar(a, "camera", "fov_y_deg", a.positive()); }, "DEG", "30"},
+    {"-viewheight", [](Apply& a) { setScalar(a, "camera", "height", a.positive()); }, "H", "none (orthographic needs it)"},
+    {"-projection", setProjection, "perspective|orthographic", "perspective"},
+    {"-step", [](Apply& a) { setScalar(a, "sampling", "step", a.positive()); }, "H", "half the smallest spacing"},
+    {"-preintegrated", [](Apply& a) { a.scene({{"sampling", {{"preintegrated", parseBoolean(a.option, a.value)}}}}); },
+     "BOOLEAN", "off"},
+    {"-earlyterm", [](Apply& a) { setScalar(a, "sampling", "early_termination", a.positive()); }, "A", "1 (off)"},
+    {"-shading", [](Apply& a) { a.scene({{"shading", {{"enabled", parseBoolean(a.option, a.value)}}}}); }, "BOOLEAN",
+     "off"},
+    {"-ambient", [](Apply& a) { setScalar(a, "shading", "ambient", a.number()); }, "KA", "0.2"},
+    {"-diffuse", [](Apply& a) { setScalar(a, "shading", "diffuse", a.number()); }, "KD", "0.7"},
+    {"-specular", [](Apply& a) { setScalar(a, "shading", "specular", a.number()); }, "KS", "0.3"},
+    {"-shininess", [](Apply& a) { setScalar(a, "shading", "shininess", a.positive()); }, "N", "32"},
+    {"-light", [](Apply& a) { a.scene({{"shading", {{"light_direction", a.vec3()}}}}); }, "X,Y,Z",
+     "0,0,1 (a headlight)"},
+    {"-strategy", [](Apply& a) { setRuntimeName(a, "strategy", "strategies"); }, "NAME", "binary-swap"},
+    {"-decomposition", [](Apply& a) { setRuntimeName(a, "decomposition", "decompositions"); }, "NAME", "kd"},
+    {"-timestep", setTimestep, "K", "0"},
+    {"-cachemem", setCacheMemory, "MB", "256"},
     {nullptr, nullptr}};
 
 void remember(Settings& s, const std::string& option, const std::string& value) {
@@ -293,6 +304,42 @@ std::string shownOption(Tcl_Interp* interp, const Settings& settings, Tcl_Obj* o
   for (const auto& [k, v] : settings.shown)
     if (k == kOptions[index].name) return v;
   return "";
+}
+
+// A list whose elements are one per line, so that an interactive shell
+// prints it as a table and a script reads it as any list.
+Tcl_Obj* linedList(const std::vector<Tcl_Obj*>& rows) {
+  std::string text;
+  for (Tcl_Obj* row : rows) {
+    Tcl_Obj* one = Tcl_NewListObj(1, &row);  // quotes the row as a list element
+    Tcl_IncrRefCount(one);
+    text += (text.empty() ? "" : "\n") + std::string(Tcl_GetString(one));
+    Tcl_DecrRefCount(one);
+  }
+  return Tcl_NewStringObj(text.c_str(), -1);
+}
+
+Tcl_Obj* optionListing(const Settings& settings) {
+  std::vector<Tcl_Obj*> rows;
+  for (const OptionRow* o = kOptions; o->name; ++o) {
+    std::string given;
+    for (const auto& [k, v] : settings.shown)
+      if (k == o->name) given = v;
+    Tcl_Obj* row[3] = {Tcl_NewStringObj(o->name, -1), Tcl_NewStringObj(given.c_str(), -1),
+                       Tcl_NewStringObj(o->byDefault ? o->byDefault : "", -1)};
+    rows.push_back(Tcl_NewListObj(3, row));
+  }
+  return linedList(rows);
+}
+
+std::string optionsHelp() {
+  std::string text;
+  for (const OptionRow* o = kOptions; o->name; ++o) {
+    std::string left = std::string("  ") + o->name + " " + (o->value ? o->value : "?");
+    left.resize(std::max<std::size_t>(left.size() + 1, 36), ' ');
+    text += left + "default: " + (o->byDefault ? o->byDefault : "?") + "\n";
+  }
+  return text;
 }
 
 Tcl_Obj* layoutObj(const std::vector<proto::ClusterSpec>& clusters) {

@@ -50,6 +50,15 @@ SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tc
 // the known options.
 std::string shownOption(Tcl_Interp* interp, const Settings& settings, Tcl_Obj* option);
 
+// `:s set` with no argument: every option as {option value default}, in
+// table order, one per line; value is "" for an option never given.
+Tcl_Obj* optionListing(const Settings& settings);
+// Every option with the form of its value and its default, one per line,
+// for `:s help set`.
+std::string optionsHelp();
+// A Tcl list of `rows`, one element per line.
+Tcl_Obj* linedList(const std::vector<Tcl_Obj*>& rows);
+
 // A cluster layout as a Tcl list of {role ranks group} triples.
 Tcl_Obj* layoutObj(const std::vector<proto::ClusterSpec>& clusters);
 

@@ -11,16 +11,26 @@
 #include <string_view>
 
 #include "session.h"
+#include "session_help.h"
 
 namespace pvr::tcl {
 namespace {
 
 using Handler = int (*)(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]);
 
+// One row per subcommand. `usage` is the argument list that wrong # args
+// and `help` print; `summary` is help's line about it. A row without them
+// is a bug that tests/pvrsh/help.test catches.
 struct Subcommand {
   const char* name;  // first field: Tcl_GetIndexFromObjStruct reads it
   Handler handler;
+  const char* usage = nullptr;    // "host?:port? ?-ranks n? ..."; "" for none
+  const char* summary = nullptr;  // one line
 };
+
+// The usage of objv[1]'s row (defined after the table), for
+// Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv)).
+const char* usageOf(Tcl_Obj* const objv[]);
 
 std::string str(Tcl_Obj* o) { return Tcl_GetString(o); }
 
@@ -50,7 +60,7 @@ std::string accountName(const std::string& v) {
 // :s open HOST[:PORT] ?-ranks N? ?-account A? ?-token-file F? ?-timeout S?
 int openCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   if (objc < 3 || objc % 2 == 0) {
-    Tcl_WrongNumArgs(interp, 2, objv, "host?:port? ?-ranks n? ?-account name? ?-token-file file? ?-timeout seconds?");
+    Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
   }
   static const char* const kOptions[] = {"-account", "-ranks", "-timeout", "-token-file", nullptr};
@@ -76,7 +86,7 @@ int openCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
 
 int closeCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   if (objc != 2) {
-    Tcl_WrongNumArgs(interp, 2, objv, nullptr);
+    Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
   }
   s.close("pvrsh: session closed");
@@ -87,7 +97,7 @@ int closeCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
 int imageCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   static const char* const kKinds[] = {"callback", "dir", "file", "window", nullptr};
   if (objc != 3 && objc != 4) {
-    Tcl_WrongNumArgs(interp, 2, objv, "window|callback|file|dir ?value?");
+    Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
   }
   int kind = 0;
@@ -145,7 +155,7 @@ int imageCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
 int listCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   static const char* const kWhat[] = {"datasets", "status", nullptr};
   if (objc != 3 && objc != 4) {
-    Tcl_WrongNumArgs(interp, 2, objv, "status|datasets ?-steps?");
+    Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
   }
   int what = 0;
@@ -171,11 +181,12 @@ int listCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   return TCL_OK;
 }
 
-// :s set OPTION VALUE ?OPTION VALUE ...?  |  :s set OPTION (its value)
+// :s set OPTION VALUE ?OPTION VALUE ...?  |  :s set OPTION (its value)  |
+// :s set (every option: {option value default}, one per line)
 int setCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
-  if (objc < 3) {
-    Tcl_WrongNumArgs(interp, 2, objv, "option ?value option value ...?");
-    return TCL_ERROR;
+  if (objc == 2) {
+    Tcl_SetObjResult(interp, optionListing(s.settings_));
+    return TCL_OK;
   }
   if (objc == 3) {
     Tcl_SetObjResult(interp, Tcl_NewStringObj(shownOption(interp, s.settings_, objv[2]).c_str(), -1));
@@ -244,7 +255,7 @@ proto::RenderTimeSteps parseTimeRange(Session& s, const std::string& range) {
 int renderCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   static const char* const kKinds[] = {"frame", "rotate", "rotation", "time", nullptr};
   if (objc < 3) {
-    Tcl_WrongNumArgs(interp, 2, objv, "rotate axis start,end:steps | time start,end?:stride? | frame");
+    Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
   }
   int kind = 0;
@@ -299,7 +310,7 @@ int performanceCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv
   // In the order of the PerformanceQuery values.
   static const char* const kQueries[] = {"memory", "comp", "cache", nullptr};
   if (objc < 3 || objc > 6) {
-    Tcl_WrongNumArgs(interp, 2, objv, "memory ?cluster? ?index? | comp ?cluster? ?latency? ?index? | cache ?cluster? ?index?");
+    Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
   }
   int query = 0;
@@ -332,7 +343,7 @@ int performanceCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv
 
 int cancelCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   if (objc != 2) {
-    Tcl_WrongNumArgs(interp, 2, objv, nullptr);
+    Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
   }
   Tcl_SetObjResult(interp, Tcl_NewIntObj(s.cancel()));
@@ -342,7 +353,7 @@ int cancelCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
 // :s wait ?-timeout S?
 int waitCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   if (objc != 2 && objc != 4) {
-    Tcl_WrongNumArgs(interp, 2, objv, "?-timeout seconds?");
+    Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
   }
   double timeout = 1e6;
@@ -360,7 +371,7 @@ int waitCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
 
 int timingCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   if (objc != 2) {
-    Tcl_WrongNumArgs(interp, 2, objv, nullptr);
+    Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
   }
   Tcl_SetObjResult(interp, s.timingObj());
@@ -370,7 +381,7 @@ int timingCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
 // :s notify ?PROC?: PROC event details... for done, cancelled and error.
 int notifyCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   if (objc != 2 && objc != 3) {
-    Tcl_WrongNumArgs(interp, 2, objv, "?command?");
+    Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
   }
   if (objc == 2) {
@@ -386,13 +397,65 @@ int notifyCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   return TCL_OK;
 }
 
+int helpCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]);
+
 const Subcommand kSubcommands[] = {
-    {"cancel", cancelCmd},   {"close", closeCmd},   {"image", imageCmd},   {"list", listCmd},
-    {"notify", notifyCmd},   {"open", openCmd},     {"performance", performanceCmd},
-    {"render", renderCmd},   {"set", setCmd},       {"timing", timingCmd}, {"wait", waitCmd},
+    {"cancel", cancelCmd, "", "stop the sequence in flight; returns the frames that will still come"},
+    {"close", closeCmd, "", "end the session and its MPI job"},
+    {"help", helpCmd, "?subcommand?", "this help; with a subcommand, its usage (and, for set, every option)"},
+    {"image", imageCmd, "window|callback|file|dir ?value?",
+     "where frames go: a Tk photo, a callback, numbered files or a directory (no value: the current one)"},
+    {"list", listCmd, "status|datasets ?-steps?", "the session's status, or the server's datasets"},
+    {"notify", notifyCmd, "?command?", "call COMMAND event details... on done, cancelled and error"},
+    {"open", openCmd, "host?:port? ?-ranks n? ?-account name? ?-token-file file? ?-timeout seconds?",
+     "connect to pvrd (port 7350 by default) and start a job of N ranks"},
+    {"performance", performanceCmd,
+     "memory ?cluster? ?index? | comp ?cluster? ?latency? ?index? | cache ?cluster? ?index?",
+     "memory, compositing or cache figures of the clusters"},
+    {"render", renderCmd, "rotate axis start,end:steps | time start,end?:stride? | frame",
+     "render one frame, a rotation or time steps; returns the number of frames"},
+    {"set", setCmd, "option ?value option value ...?",
+     "change settings (no argument: every option with its value and default; one: its value)"},
+    {"timing", timingCmd, "", "the timings of the latest sequence, one dict per frame"},
+    {"wait", waitCmd, "?-timeout seconds?", "run the event loop until the sequences and settings are done"},
     {nullptr, nullptr}};
 
+const char* usageOf(Tcl_Obj* const objv[]) {
+  for (const Subcommand* c = kSubcommands; c->name; ++c)
+    if (c->name == std::string_view(Tcl_GetString(objv[1]))) return c->usage && *c->usage ? c->usage : nullptr;
+  return nullptr;
+}
+
+// :s help ?SUBCOMMAND?: every subcommand with its usage and summary, from
+// kSubcommands; one subcommand's, and for `set` every option too.
+int helpCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc > 3) {
+    Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
+    return TCL_ERROR;
+  }
+  const std::string text = subcommandHelp(s.name_, objc == 3 ? Tcl_GetString(objv[2]) : "");
+  Tcl_SetObjResult(interp, Tcl_NewStringObj(text.c_str(), int(text.size()) - 1));  // no final newline
+  return TCL_OK;
+}
+
 }  // namespace
+
+std::string subcommandHelp(const std::string& object, const std::string& subcommand) {
+  std::string text;
+  for (const Subcommand* c = kSubcommands; c->name; ++c) {
+    if (!subcommand.empty() && subcommand != c->name) continue;
+    text += object + " " + c->name + (c->usage && *c->usage ? " " + std::string(c->usage) : "") + "\n    " +
+            (c->summary ? c->summary : "?") + "\n";
+  }
+  if (text.empty()) {
+    std::string names;
+    for (const Subcommand* c = kSubcommands; c->name; ++c) names += std::string(names.empty() ? "" : ", ") + c->name;
+    throw TclError({"PVR", "ARGS", "SUBCOMMAND"}, "help: no subcommand \"" + subcommand + "\"; there are " + names);
+  }
+  if (subcommand == "set") text += "options:\n" + optionsHelp();
+  if (subcommand.empty()) text += "(" + object + " help SUBCOMMAND for one; docs/pvrsh.md and man pvrsh for more)\n";
+  return text;
+}
 
 int Session::objCmd(ClientData data, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   auto* self = static_cast<Session*>(data);

@@ -1,19 +1,28 @@
-// pvr-render: render one scene in this process, all cores.
+// pvr-render: render one scene, or one volume file with defaults, in this
+// process, all cores.
 //
-//   pvr-render SCENE.json -o OUT.exr|OUT.png [--step H] [--size WxH] [--threads N]
-//              [--frames N] [--preintegrated on|off] [--skip on|off]
+//   pvr-render SCENE.json|VOLUME -o OUT.exr|OUT.png [options]   (--help lists them)
 //
-// EXR holds linear premultiplied RGBA float32 before the background; PNG is
-// composited over the background in sRGB. Prints time per frame and samples
-// per second; --frames renders the same frame N times and reports the median.
+// A volume file (NIfTI, NRRD, the .json sidecar of ../shared/data, any
+// registered format) renders with the automatic camera, a white ramp over
+// the data's value range (computed by the reader's pass over the voxels,
+// so free) and shading on. EXR holds linear premultiplied RGBA float32
+// before the background; PNG is composited over the background in sRGB.
+// Prints time per frame and samples per second; --frames renders the same
+// frame N times and reports the median.
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "error.h"
 #include "image_io.h"
+#include "io/volume_io.h"
 #include "raycast/raycaster.h"
 #include "scene.h"
 #include "scene_volume.h"
@@ -24,14 +33,38 @@ struct Args {
   std::string scene, output;
   double step = 0;
   int width = 0, height = 0, threads = 0, frames = 1;
-  int preintegrated = -1, skip = -1;  // -1: as the scene says
+  int preintegrated = -1, skip = -1, shading = -1;  // -1: as the scene says
 };
 
+// The command line and every option, one line each: --help prints it, a
+// bad command line its first line; man/pvr-render.1 follows it.
+constexpr const char* kUsage =
+    "usage: pvr-render SCENE.json|VOLUME -o OUT.exr|OUT.png [OPTION VALUE ...]\n"
+    "\n"
+    "Renders one scene (docs/scene.md), or one volume file with defaults, in this process.\n"
+    "A VOLUME (.nii, .nii.gz, .nhdr, .nrrd, the .json sidecar of a raw file) gets the automatic\n"
+    "camera, a white opacity ramp over the data's value range (clear below its first tenth) and\n"
+    "shading on.\n"
+    "\n"
+    "options:\n"
+    "  -o OUT.exr|OUT.png          the image (EXR: linear premultiplied float; PNG: sRGB over the background)\n"
+    "  --size WxH                  image size in pixels (default: the scene's, 512x512)\n"
+    "  --step H                    sample distance in world units (default: half the smallest spacing)\n"
+    "  --shading on|off            gradient shading (default: the scene's; on for a volume file)\n"
+    "  --preintegrated on|off      pre-integrated classification (default: the scene's)\n"
+    "  --skip on|off               empty-space skipping (default on)\n"
+    "  --threads N                 render threads (default: all cores)\n"
+    "  --frames N                  render N times and report the median time (default 1)\n"
+    "  -h, --help                  print this help and exit\n"
+    "\n"
+    "examples:\n"
+    "  pvr-render head.nii.gz -o head.png\n"
+    "  pvr-render examples/scenes/ct_head_bone.json -o bone.exr --size 1024x1024\n";
+
 [[noreturn]] void usage(const std::string& why) {
-  std::fprintf(stderr,
-               "pvr-render: %s\nusage: pvr-render SCENE.json -o OUT.exr|OUT.png [--step H] "
-               "[--size WxH] [--threads N] [--frames N] [--preintegrated on|off] [--skip on|off]\n",
-               why.c_str());
+  const std::string text(kUsage);
+  std::fprintf(stderr, "pvr-render: %s\n%s(pvr-render --help lists every option)\n", why.c_str(),
+               text.substr(0, text.find('\n') + 1).c_str());
   std::exit(2);
 }
 
@@ -50,6 +83,10 @@ Args parseArgs(int argc, char** argv) {
       if (i + 1 >= argc) usage(arg + " needs a value");
       return argv[++i];
     };
+    if (arg == "-h" || arg == "--help") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    }
     try {
       if (arg == "-o") a.output = value();
       else if (arg == "--step") {
@@ -60,6 +97,7 @@ Args parseArgs(int argc, char** argv) {
       else if (arg == "--frames") a.frames = std::max(1, std::stoi(value()));
       else if (arg == "--preintegrated") a.preintegrated = onOff(arg, value());
       else if (arg == "--skip") a.skip = onOff(arg, value());
+      else if (arg == "--shading") a.shading = onOff(arg, value());
       else if (arg == "--size") {
         const std::string v = value();
         if (std::sscanf(v.c_str(), "%dx%d", &a.width, &a.height) != 2 || a.width < 1 || a.height < 1 ||
@@ -72,9 +110,36 @@ Args parseArgs(int argc, char** argv) {
       usage(arg + ": not a number");
     }
   }
-  if (a.scene.empty()) usage("no scene file");
+  if (a.scene.empty()) usage("no scene or volume file");
   if (a.output.empty()) usage("no output file (-o)");
   return a;
+}
+
+// A scene document is a JSON object with "volume" or "volumes"; any other
+// file (a JSON sidecar included) is a volume for a format to open.
+bool isSceneFile(const std::string& path) {
+  if (std::filesystem::path(path).extension() != ".json") return false;
+  std::ifstream in(path);
+  const auto doc = nlohmann::json::parse(in, nullptr, false);
+  return doc.is_object() && (doc.contains("volume") || doc.contains("volumes"));
+}
+
+// The scene of a bare volume file: defaults fit to the data. The white
+// opacity ramp spans the finite values the reader found, starting at a
+// tenth of the range so that air and scanner noise (which fill most of a
+// CT or MRI box) stay clear instead of filling the frame with haze; a
+// constant volume keeps the scene's default ramp. Shading is on because
+// what people look for in real data are surfaces.
+constexpr double kRampStart = 0.1;
+pvr::core::Scene sceneOfVolume(const std::string& path, const pvr::core::Brick& volume) {
+  using nlohmann::json;
+  json doc = {{"volume", {{"file", std::filesystem::absolute(path).string()}}}, {"shading", {{"enabled", true}}}};
+  const pvr::core::ValueRange& range = volume.valueRange();
+  if (range.max > range.min)
+    doc["transfer_function"] = {{"points", json::array({json::array({range.min, 1, 1, 1, 0}),
+                                                         json::array({range.min + kRampStart * (range.max - range.min), 1, 1, 1, 0}),
+                                                         json::array({range.max, 1, 1, 1, 1})})}};
+  return pvr::core::parseScene(doc, ".");
 }
 
 }  // namespace
@@ -83,15 +148,24 @@ int main(int argc, char** argv) {
   using namespace pvr::core;
   const Args args = parseArgs(argc, argv);
   try {
-    Scene scene = loadSceneFile(args.scene);
+    Scene scene;
+    std::unique_ptr<VolumeSource> source;
+    Brick volume;
+    if (isSceneFile(args.scene)) {
+      scene = loadSceneFile(args.scene);
+      source = openSceneVolume(scene.volumes.front().source);
+      // The scene's time step of a series (step 0, the volume itself, otherwise).
+      volume = source->step(scene.volumes.front().source.timestep).readAll();
+    } else {
+      source = openVolumeFile(args.scene);
+      volume = source->readAll();
+      scene = sceneOfVolume(args.scene, volume);
+    }
     if (args.step > 0) scene.sampling.step = args.step;
     if (args.width > 0) scene.image.width = args.width, scene.image.height = args.height;
     if (args.preintegrated >= 0) scene.sampling.preintegrated = args.preintegrated == 1;
-
-    const auto source = openSceneVolume(scene.volumes.front().source);
+    if (args.shading >= 0) scene.shading.enabled = args.shading == 1;
     resolveDefaults(scene, source->grid());
-    // The scene's time step of a series (step 0, the volume itself, otherwise).
-    const Brick volume = source->step(scene.volumes.front().source.timestep).readAll();
 
     RenderOptions options = renderOptionsFor(scene);
     if (args.skip >= 0) options.skipEmpty = args.skip == 1;
