@@ -3,6 +3,7 @@
 #include <dlfcn.h>
 
 #include <cstdlib>
+#include <filesystem>
 
 #include "error.h"
 
@@ -12,9 +13,23 @@ namespace {
 
 using WriteImage = int (*)(const core::Image*, const double*, const char*, char*, std::size_t);
 
-WriteImage loadWriter() {
+// The module: $PVR_IMAGE_WRITER; else an installed one, PREFIX/lib/pvr
+// beside PREFIX/bin/pvr-node (cmake --install puts it there); else the
+// build tree's.
+std::string writerModule() {
   const char* env = std::getenv("PVR_IMAGE_WRITER");
-  const std::string module = env && *env ? env : PVR_IMAGE_WRITER_MODULE;
+  if (env && *env) return env;
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const auto installed = exe.parent_path().parent_path() / "lib" / "pvr" / PVR_IMAGE_WRITER_NAME;
+    if (std::filesystem::is_regular_file(installed, ec)) return installed.string();
+  }
+  return PVR_IMAGE_WRITER_MODULE;
+}
+
+WriteImage loadWriter() {
+  const std::string module = writerModule();
   // Loaded once, kept for the life of the process.
   void* handle = ::dlopen(module.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle) throw Error(ErrorCode::kIo, "cannot load the image writer " + module + ": " + ::dlerror());

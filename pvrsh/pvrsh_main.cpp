@@ -41,13 +41,16 @@ constexpr const char* kUsage =
     "  % :s image file head.png; :s render frame; :s wait\n";
 
 // Finds package pvr next to the executable (installed: PREFIX/bin/../lib),
-// in the build tree, or on the usual auto_path, then loads it.
+// in the build tree, or on the usual auto_path, then loads it. Each
+// directory goes to the front, the one next to the executable last, so an
+// installed pvrsh loads its own package even while the build tree exists.
 int loadPvr(Tcl_Interp* interp) {
   const std::string script = std::string(R"TCL(
     set exe [file dirname [file normalize [info nameofexecutable]]]
-    foreach dir [list [file join [file dirname $exe] lib] )TCL") + "{" PVR_BUILD_PACKAGE_DIR "}" + R"TCL(] {
-      if {[file exists [file join $dir pvr pkgIndex.tcl]] && $dir ni $::auto_path} {
-        set ::auto_path [linsert $::auto_path 0 $dir]
+    foreach dir [list )TCL") + "{" PVR_BUILD_PACKAGE_DIR "}" + R"TCL( [file join [file dirname $exe] lib]] {
+      # To the front even when Tcl put it further back (it adds PREFIX/lib).
+      if {[file exists [file join $dir pvr pkgIndex.tcl]]} {
+        set ::auto_path [linsert [lsearch -all -inline -not -exact $::auto_path $dir] 0 $dir]
       }
     }
     unset exe dir
