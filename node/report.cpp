@@ -59,17 +59,18 @@ std::string formatReport(const FrameResult& result, const FrameOptions& options,
               options.strategy.c_str(), std::string(decompositionName(options.decomposition)).c_str(),
               result.scene.image.width, result.scene.image.height);
   out += "hosts: " + hostRuns(hosts) + "\n";
-  out += "time (s)    max       mean      min\n";
+  out += "time (s)    max       mean    median       min\n";
   double sumOfMax = output.write;
   for (const Column& c : timeColumns()) {
-    double mx = 0, sum = 0, mn = 1e300;
-    for (const RankReport& r : ranks) {
-      mx = std::max(mx, c.value(r));
-      mn = std::min(mn, c.value(r));
-      sum += c.value(r);
-    }
-    sumOfMax += mx;
-    out += line("%-8s %9.4f %9.4f %9.4f\n", c.name, mx, sum / n, mn);
+    std::vector<double> v;
+    for (const RankReport& r : ranks) v.push_back(c.value(r));
+    std::sort(v.begin(), v.end());
+    double sum = 0;
+    for (double x : v) sum += x;
+    const std::size_t half = v.size() / 2;
+    const double median = v.size() % 2 ? v[half] : 0.5 * (v[half - 1] + v[half]);
+    sumOfMax += v.back();
+    out += line("%-8s %9.4f %9.4f %9.4f %9.4f\n", c.name, v.back(), sum / n, median, v.front());
   }
   out += line("%-8s %9.4f   (rank 0 writes the image)\n", "write", output.write);
   out += line("%-8s %9.4f   (phases follow one another on each rank; read and prep are the reader's "

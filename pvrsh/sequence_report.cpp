@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <iterator>
+#include <vector>
 
 #include "session.h"
 
@@ -70,28 +72,68 @@ void Session::printProgress(const Sequence& seq) const {
   std::fflush(stderr);
 }
 
+// The table of a finished sequence: one row per frame with each phase in
+// milliseconds and the frame's arrival (seconds since the request went
+// out), then mean, median and max rows over the frames, then each phase's
+// total and share.
 void Session::printTable(const Sequence& seq) const {
   const double total = seq.frames.back().arrival;
   std::fprintf(stderr, "%s %s: %zu frames in %.3f s (%.2f fps)%s\n", name_.c_str(), seq.label.c_str(),
                seq.frames.size(), total, total > 0 ? double(seq.frames.size()) / total : 0.0,
                seq.cancelled ? ", cancelled" : "");
   std::fprintf(stderr, "%6s", "frame");
-  for (const Phase& p : kPhases) std::fprintf(stderr, " %9s", p.name);
-  std::fprintf(stderr, " %9s\n", "arrival");
-  proto::FrameTiming sum;
+  for (const Phase& p : kPhases) std::fprintf(stderr, " %6s ms", p.name);
+  std::fprintf(stderr, " %9s s\n", "arrival");
+  // Column k: phase k in seconds, the last one the arrival.
+  constexpr std::size_t kColumns = std::size(kPhases) + 1;
+  std::vector<std::vector<double>> columns(kColumns);
   for (const auto& r : seq.frames) {
     std::fprintf(stderr, "%6u", r.frame);
-    for (const Phase& p : kPhases) {
-      std::fprintf(stderr, " %9.4f", r.timing.*p.value);
-      sum.*p.value += r.timing.*p.value;
+    for (std::size_t k = 0; k < std::size(kPhases); ++k) {
+      const double v = r.timing.*kPhases[k].value;
+      std::fprintf(stderr, " %9.2f", v * 1e3);
+      columns[k].push_back(v);
     }
-    std::fprintf(stderr, " %9.4f\n", r.arrival);
+    std::fprintf(stderr, " %11.4f\n", r.arrival);
+    columns.back().push_back(r.arrival);
+  }
+  // Summary rows; the arrival column's are of the gaps between arrivals
+  // (the first frame's from the request), the time each frame added.
+  std::vector<double>& gaps = columns.back();
+  for (std::size_t i = gaps.size(); i-- > 1;) gaps[i] -= gaps[i - 1];
+  const char* const kRows[] = {"mean", "median", "max"};
+  for (int row = 0; row < 3; ++row) {
+    std::fprintf(stderr, "%6s", kRows[row]);
+    for (std::size_t k = 0; k < kColumns; ++k) {
+      std::vector<double> v = columns[k];
+      std::sort(v.begin(), v.end());
+      double x = v.back();
+      if (row == 0) {
+        x = 0;
+        for (double d : v) x += d;
+        x /= double(v.size());
+      } else if (row == 1) {
+        x = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+      }
+      if (k + 1 < kColumns)
+        std::fprintf(stderr, " %9.2f", x * 1e3);
+      else
+        std::fprintf(stderr, " %11.4f", x);
+    }
+    std::fprintf(stderr, "%s\n", row == 0 ? "  (arrival: gap between frames)" : "");
   }
   double all = 0;
-  for (const Phase& p : kPhases) all += sum.*p.value;
+  for (const Phase& p : kPhases) {
+    double sum = 0;
+    for (const auto& r : seq.frames) sum += r.timing.*p.value;
+    all += sum;
+  }
   std::fprintf(stderr, "breakdown (s, share):");
-  for (const Phase& p : kPhases)
-    std::fprintf(stderr, " %s %.3f (%.0f%%)", p.name, sum.*p.value, all > 0 ? 100.0 * sum.*p.value / all : 0.0);
+  for (const Phase& p : kPhases) {
+    double sum = 0;
+    for (const auto& r : seq.frames) sum += r.timing.*p.value;
+    std::fprintf(stderr, " %s %.3f (%.0f%%)", p.name, sum, all > 0 ? 100.0 * sum / all : 0.0);
+  }
   std::fputc('\n', stderr);
 }
 
