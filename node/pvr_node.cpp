@@ -79,6 +79,7 @@ std::string usage() {
          "  --server                   serve one pvrd session\n"
          "  --connect HOST:PORT        the session handler to connect to\n"
          "  --data-dir DIR             the data directory datasets resolve in\n"
+         "  --stall-timeout S          a rank without progress for S s ends the job (default 30)\n"
          "catalog:\n"
          "  --catalog DIR              print the datasets of DIR, one per line, and exit\n"
          "  -h, --help                 print this help and exit\n"
