@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "camera_request.h"
 #include "dispatch.h"
 #include "rotation.h"
 #include "status.h"
@@ -65,20 +66,52 @@ void Master::layout(const std::vector<proto::ClusterSpec>& clusters, std::uint32
 }
 
 void Master::on(const proto::SetScene& request, std::uint32_t id) {
+  // A camera part that needs the camera in force (camera_request.h) goes
+  // after the rest of the patch, which may load the dataset that places it.
+  std::optional<CameraRequest> camera;
+  proto::SetScene rest = request;
+  if (!request.sceneJson.empty() && !proto::checkJsonDepth(request.sceneJson, "scene")) {
+    nlohmann::json patch = nlohmann::json::parse(request.sceneJson, nullptr, false);
+    if (patch.is_object()) {  // anything else patchScene refuses in its words
+      CameraRequest taken = takeCameraRequest(patch);
+      if (!taken.empty() && !mergesIntoDocument(taken, scene_.doc)) {
+        camera = std::move(taken);
+        rest.sceneJson = patch.empty() ? std::string() : patch.dump();
+      }
+    }
+  }
+  if (!camera || !rest.sceneJson.empty() || !rest.dataset.empty())
+    if (auto refused = applyScene(camera ? rest : request)) return sendError(*refused, id);
+  if (camera) {
+    if (!state_.source)
+      throw Error(pvr::ErrorCode::kInvalidArgument,
+                  "camera: this change moves the camera in force, which is placed once a dataset is loaded; "
+                  "set a dataset first (or give eye and look_at)");
+    const core::ImageSpec& image = state_.scene.image;
+    const core::CameraSpec automatic = core::automaticCamera(state_.source->grid(), image.width, image.height);
+    const nlohmann::json section =
+        cameraSectionAfter(*camera, state_.scene.camera, automatic, double(image.width) / double(image.height));
+    if (auto refused = applyScene(proto::SetScene{"", nlohmann::json{{"camera", section}}.dump()}))
+      return sendError(*refused, id);
+  }
+  send(proto::Ok{}, id);
+}
+
+std::optional<proto::ProtocolError> Master::applyScene(const proto::SetScene& request) {
   auto patched = patchScene(scene_, request, state_.dataDir);
-  if (const auto* refused = std::get_if<proto::ProtocolError>(&patched)) return sendError(*refused, id);
+  if (const auto* refused = std::get_if<proto::ProtocolError>(&patched)) return *refused;
   SessionScene& next = std::get<SessionScene>(patched);
   // Without a volume there is nothing for the ranks to load yet: the
   // checked scene waits for the dataset.
   if (next.hasVolume()) {
-    if (auto f = invoke(state_, actions::SetScene{next.doc.dump(), next.settings})) return sendError(wireError(*f, state_.hosts), id);
+    if (auto f = invoke(state_, actions::SetScene{next.doc.dump(), next.settings})) return wireError(*f, state_.hosts);
   }
   scene_ = std::move(next);
-  send(proto::Ok{}, id);
+  return std::nullopt;
 }
 
 void Master::on(const proto::StatusRequest&, std::uint32_t id) {
-  send(proto::StatusReply{statusEntries(state_, {running_ != 0, framesSent_, scene_.settings})}, id);
+  send(proto::StatusReply{statusEntries(state_, {running_ != 0, framesSent_, scene_.settings, scene_.doc.contains("camera")})}, id);
 }
 
 void Master::on(const proto::RenderFrame&, std::uint32_t id) {

@@ -47,6 +47,9 @@ class Master {
   void on(const M& m, std::uint32_t id);
 
   void layout(const std::vector<proto::ClusterSpec>& clusters, std::uint32_t id);
+  // Checks and applies one scene patch (patchScene, then the ranks); the
+  // error that refuses it, and then nothing changed.
+  std::optional<proto::ProtocolError> applyScene(const proto::SetScene& request);
   // Renders frames 0 .. count - 1, frame k seen by cameraOf(k) at time
   // step stepOf(k), in waves of one frame per group; the request's frames
   // go out in order, the last FINAL. Each wave names the steps of the

@@ -145,6 +145,7 @@ std::vector<proto::KeyValue> statusEntries(const NodeState& state, const Session
   };
   if (state.source) {
     addDataset(state, out);
+    out.push_back({"camera_automatic", session.cameraSet ? "0" : "1"});
     addTimeSteps(state, settings, out);
   }
   return out;

@@ -17,6 +17,7 @@ struct SessionStatus {
   bool rendering = false;
   std::uint32_t framesSent = 0;
   const RuntimeSettings& settings;  // the session's, whether a dataset is loaded or not
+  bool cameraSet = false;           // the scene sets a camera (else it is the automatic one)
 };
 
 std::vector<proto::KeyValue> statusEntries(const NodeState& state, const SessionStatus& session);

@@ -43,6 +43,12 @@ struct Apply {
     mergeKeepingNulls(change.patch, patch);
     settings.scene.merge_patch(patch);
   }
+  // A camera move goes out once, in the order given; the server applies it
+  // to the camera in force (docs/scene.md, "Moving the camera").
+  void cameraMove(const json& move) {
+    change.patch["camera_moves"].push_back(move);
+    settings.cameraMoves.push_back(move);
+  }
   std::vector<double> numbers(int count) const { return parseNumbers(option, value, count); }
   double number() const { return numbers(1)[0]; }
   double positive() const {
@@ -148,9 +154,20 @@ void setTransferPreset(Apply& a) {
   a.scene(transferSource("paraview", std::move(preset)));
 }
 
+// -camera auto|reset: back to the automatic camera; moves given before it
+// (in this call, or waiting for open) are dropped, later ones apply to it.
 void setCamera(Apply& a) {
-  if (a.value != "auto") argsError("CAMERA", "-camera takes 'auto' (set -eye, -lookat, -up for a fixed camera)");
+  if (a.value != "auto" && a.value != "reset")
+    argsError("CAMERA", "-camera takes 'reset' or 'auto' (set -eye, -lookat, -up for a fixed camera)");
   a.scene({{"camera", nullptr}});
+  a.change.patch.erase("camera_moves");
+  a.settings.cameraMoves = json::array();
+}
+
+// -pan DX,DY: fractions of the view's width and height.
+void setPan(Apply& a) {
+  const auto v = a.numbers(2);
+  a.cameraMove({{"pan", {v[0], v[1]}}});
 }
 
 void setProjection(Apply& a) {
@@ -207,7 +224,7 @@ const OptionRow kOptions[] = {
     {"-tfpreset", setTransferPreset, "FILE", "none"},
     {"-unitdist", [](Apply& a) { setScalar(a, "transfer_function", "unit_distance", a.positive()); }, "D",
      "one voxel (the smallest spacing)"},
-    {"-camera", setCamera, "auto", "auto"},
+    {"-camera", setCamera, "auto|reset", "auto"},
     {"-eye", [](Apply& a) { a.scene({{"camera", {{"eye", a.vec3()}}}}); }, "X,Y,Z", "automatic"},
     {"-lookat", [](Apply& a) { a.scene({{"camera", {{"look_at", a.vec3()}}}}); }, "X,Y,Z",
      "automatic: the domain's centre"},
@@ -215,6 +232,11 @@ const OptionRow kOptions[] = {
     {"-fov", [](Apply& a) { setScalar(a, "camera", "fov_y_deg", a.positive()); }, "DEG", "30"},
     {"-viewheight", [](Apply& a) { setScalar(a, "camera", "height", a.positive()); }, "H", "none (orthographic needs it)"},
     {"-projection", setProjection, "perspective|orthographic", "perspective"},
+    {"-zoom", [](Apply& a) { a.cameraMove({{"zoom", a.positive()}}); }, "F", "none: a move, applied once"},
+    {"-pan", setPan, "DX,DY", "none: a move, in fractions of the view"},
+    {"-azimuth", [](Apply& a) { a.cameraMove({{"azimuth", a.number()}}); }, "DEG", "none: a move about look_at"},
+    {"-elevation", [](Apply& a) { a.cameraMove({{"elevation", a.number()}}); }, "DEG", "none: a move about look_at"},
+    {"-view", [](Apply& a) { a.cameraMove({{"view", a.value}}); }, "+x|-x|+y|-y|+z|-z|iso", "none: a move"},
     {"-step", [](Apply& a) { setScalar(a, "sampling", "step", a.positive()); }, "H", "half the smallest spacing"},
     {"-preintegrated", [](Apply& a) { a.scene({{"sampling", {{"preintegrated", parseBoolean(a.option, a.value)}}}}); },
      "BOOLEAN", "off"},
@@ -340,6 +362,12 @@ std::string optionsHelp() {
     text += left + "default: " + (o->byDefault ? o->byDefault : "?") + "\n";
   }
   return text;
+}
+
+json openingScene(const Settings& settings) {
+  json scene = settings.scene;
+  if (!settings.cameraMoves.empty()) scene["camera_moves"] = settings.cameraMoves;
+  return scene;
 }
 
 Tcl_Obj* layoutObj(const std::vector<proto::ClusterSpec>& clusters) {

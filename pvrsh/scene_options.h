@@ -23,6 +23,9 @@ struct Settings {
   nlohmann::json scene = nlohmann::json::object();  // every scene key set so far, merged
   std::vector<proto::ClusterSpec> clusters;     // desired layout; empty: the master's default
   std::vector<std::pair<std::string, std::string>> shown;  // option -> value as given, first-set order
+  // Camera moves (-zoom, -pan, ...) not sent yet: they change the camera in
+  // force once, so they are sent once (by open, before it) and not kept.
+  nlohmann::json cameraMoves = nlohmann::json::array();
 };
 
 // What one `set` call changed, to be sent to an open session.
@@ -58,6 +61,9 @@ Tcl_Obj* optionListing(const Settings& settings);
 std::string optionsHelp();
 // A Tcl list of `rows`, one element per line.
 Tcl_Obj* linedList(const std::vector<Tcl_Obj*>& rows);
+// The scene patch `open` sends: every key set so far and the camera moves
+// not sent yet ("camera_moves", docs/scene.md).
+nlohmann::json openingScene(const Settings& settings);
 
 // A cluster layout as a Tcl list of {role ranks group} triples.
 Tcl_Obj* layoutObj(const std::vector<proto::ClusterSpec>& clusters);

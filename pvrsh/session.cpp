@@ -97,6 +97,7 @@ void Session::applySettings(const SettingsChange& change) {
     send(proto::SetScene{change.dataset ? settings_.dataset : std::string(),
                          change.patch.empty() ? std::string() : change.patch.dump()},
          false);
+  settings_.cameraMoves = nlohmann::json::array();  // sent: moves apply once
   // Figure 5 sets render and compositing clusters in two commands; the
   // layout goes out whole with the next render, so no half layout is sent.
   if (change.layout) layoutPending_ = true;

@@ -80,6 +80,9 @@ class Session : public Connection::Listener {
   std::vector<proto::Message> query(const proto::Message& request, double timeoutSeconds,
                                     const std::function<void(const proto::Message&)>& onProgress = {});
   Tcl_Obj* statusObj();
+  // The camera in force as a dict (automatic, projection, eye, look_at, up,
+  // fov_y_deg or height); errors when the server cannot say now.
+  Tcl_Obj* cameraObj();
   Tcl_Obj* timingObj() const;
   // Throws {PVR STATE NOTOPEN} naming `what` unless the session is open.
   void requireOpen(const char* what) const;

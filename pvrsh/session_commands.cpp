@@ -341,6 +341,16 @@ int performanceCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv
   throw TclError({"PVR", "PROTOCOL", "UNEXPECTED_MESSAGE"}, "performance: the server sent no PerformanceReply");
 }
 
+// :s camera: the camera in force (session_camera.cpp).
+int cameraCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc != 2) {
+    Tcl_WrongNumArgs(interp, 2, objv, nullptr);
+    return TCL_ERROR;
+  }
+  Tcl_SetObjResult(interp, s.cameraObj());
+  return TCL_OK;
+}
+
 int cancelCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   if (objc != 2) {
     Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
@@ -400,6 +410,7 @@ int notifyCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
 int helpCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]);
 
 const Subcommand kSubcommands[] = {
+    {"camera", cameraCmd, "", "the camera in force (automatic or set) as a dict"},
     {"cancel", cancelCmd, "", "stop the sequence in flight; returns the frames that will still come"},
     {"close", closeCmd, "", "end the session and its MPI job"},
     {"help", helpCmd, "?subcommand?", "this help; with a subcommand, its usage (and, for set, every option)"},

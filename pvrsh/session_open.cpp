@@ -101,8 +101,10 @@ void Session::open(const OpenRequest& request) {
     state_ = State::kOpen;
     layoutPending_ = false;
     // Step 4: what was set before the session opened.
-    if (!settings_.dataset.empty() || !settings_.scene.empty())
-      send(proto::SetScene{settings_.dataset, settings_.scene.empty() ? std::string() : settings_.scene.dump()}, false);
+    const nlohmann::json scene = openingScene(settings_);
+    if (!settings_.dataset.empty() || !scene.empty())
+      send(proto::SetScene{settings_.dataset, scene.empty() ? std::string() : scene.dump()}, false);
+    settings_.cameraMoves = nlohmann::json::array();
   } catch (...) {
     if (!deleted_) {
       conn_.reset();
