@@ -108,7 +108,7 @@ proc ::pvr::gui::main {args} {
     $session image window $::pvr::gui::image
     $session image callback ::pvr::gui::onFrame
     $session notify ::pvr::gui::onNotify
-    ::pvr::gui::view::attach .view.image [list ::pvr::gui::send] ::pvr::gui::readScene
+    ::pvr::gui::view::attach .view.image [list ::pvr::gui::send] ::pvr::gui::readScene [list $session set]
     if {$connect} {
         after idle ::pvr::gui::connect
     }
@@ -159,7 +159,7 @@ proc ::pvr::gui::buildMain {} {
     pack $f.scale $f.step -side left -padx 2
 
     # View: buttons turn by 15 degrees; the image turns by dragging.
-    set f [ttk::labelframe .ctl.view -text "View (drag the image to rotate)" -padding 4]
+    set f [ttk::labelframe .ctl.view -text "View (drag: rotate, wheel: zoom, middle drag: pan)" -padding 4]
     ttk::button $f.left -text "\u25c0" -width 3 -command {::pvr::gui::view::turn -15 0}
     ttk::button $f.right -text "\u25b6" -width 3 -command {::pvr::gui::view::turn 15 0}
     ttk::button $f.up -text "\u25b2" -width 3 -command {::pvr::gui::view::turn 0 15}
@@ -170,6 +170,13 @@ proc ::pvr::gui::buildMain {} {
     grid x $f.up x $f.reset -padx 1 -pady 1
     grid $f.left $f.render $f.right $f.angles -padx 1 -pady 1
     grid x $f.down x -padx 1 -pady 1
+    # Standard views (camera moves on the server, gui_view.tcl).
+    ttk::frame $f.std
+    foreach name {+x -x +y -y +z -z iso} {
+        ttk::button $f.std.v$name -text $name -width 3 -command [list ::pvr::gui::view::move -view $name]
+        pack $f.std.v$name -side left -padx 1
+    }
+    grid $f.std - - - -pady 2 -sticky w
     trace add variable ::pvr::gui::view::azimuth write ::pvr::gui::showAngles
     trace add variable ::pvr::gui::view::elevation write ::pvr::gui::showAngles
     showAngles
@@ -571,6 +578,11 @@ proc ::pvr::gui::renderSequence {} {
         return
     }
     set start [clock microseconds]
+    # The sequence turns the view on screen, not the one reported before a drag.
+    if {[catch {::pvr::gui::view::commit} message]} {
+        status "render rotate: $message" error
+        return
+    }
     if {[catch {$session render rotate $opt(axis) $opt(range)} total]} {
         status "render rotate: $total" error
         return

@@ -15,6 +15,15 @@
 # where F is the orthonormal frame {view direction, right, up} of an orbit
 # camera and E0 the reported camera's elevation.
 #
+# Zoom (mouse wheel), pan (middle-button drag), the standard views and
+# Reset are camera moves of `:s set` (-zoom, -pan, -view, -camera reset),
+# which the server applies to the camera in force (docs/scene.md, "Moving
+# the camera"). Before sending them, and before a rotation sequence, the
+# orbit is committed the same way (-elevation E-E0 -azimuth A turn the
+# reported camera exactly as the orbit frame shows it), and the new
+# camera becomes the orbit's base: so the server's camera is the view on
+# screen, and a sequence starts from it.
+#
 # Coalescing: at most one request is in flight. A drag that moves while a
 # frame is being rendered only records the newest angles; when the frame
 # arrives (or fails) the newest angles are sent, once.
@@ -33,6 +42,12 @@ namespace eval ::pvr::gui::view {
     variable stepsPerTurn 36000
     # Degrees per pixel of drag.
     variable degreesPerPixel 0.5
+    # The command prefix that sets session options (`:s set`), and the
+    # camera moves waiting for the next request, as its words.
+    variable setter {}
+    variable moves {}
+    # Magnification per wheel step.
+    variable zoomStep 1.25
 }
 
 # ---- Vector helpers on 3-lists ----
@@ -192,14 +207,109 @@ namespace eval ::pvr::gui::view {
 # ::pvr::gui::view::attach --
 #   Binds drags on widget `w` to the view; `command` sends one request,
 #   `camera` returns the server's camera (see cameraSource).
-proc ::pvr::gui::view::attach {w command camera} {
+#   `set` sets session options (camera moves).
+proc ::pvr::gui::view::attach {w command camera set} {
     variable sender
     variable cameraSource
+    variable setter
     set sender $command
     set cameraSource $camera
+    set setter $set
     bind $w <ButtonPress-1> [list ::pvr::gui::view::dragStart %x %y]
     bind $w <B1-Motion> [list ::pvr::gui::view::dragMotion %x %y]
     bind $w <ButtonRelease-1> [list ::pvr::gui::view::dragEnd %x %y]
+    # The wheel: Button-4/5 on X11, <MouseWheel> with a delta elsewhere.
+    bind $w <Button-4> {::pvr::gui::view::wheel 1}
+    bind $w <Button-5> {::pvr::gui::view::wheel -1}
+    bind $w <MouseWheel> {::pvr::gui::view::wheel %D}
+    bind $w <ButtonPress-2> [list ::pvr::gui::view::panStart %x %y]
+    bind $w <B2-Motion> [list ::pvr::gui::view::panMotion %W %x %y]
+    bind $w <ButtonRelease-2> [list ::pvr::gui::view::panEnd %W %x %y]
+}
+
+# ::pvr::gui::view::move --
+#   Queues the camera move `option value` (a `:s set` pair) and asks for a
+#   frame. Consecutive zooms multiply and consecutive pans add, so a fast
+#   wheel or drag sends one move.
+proc ::pvr::gui::view::move {option value} {
+    variable moves
+    lassign [lrange $moves end-1 end] lastOption lastValue
+    if {$option eq "-zoom" && $lastOption eq "-zoom"} {
+        lset moves end [expr {$lastValue * $value}]
+    } elseif {$option eq "-pan" && $lastOption eq "-pan"} {
+        lset moves end [join [lmap a [split $lastValue ,] b [split $value ,] {expr {$a + $b}}] ,]
+    } elseif {$option eq "-camera" || $option eq "-view"} {
+        # They replace the orientation: what was queued before is moot.
+        set moves [list $option $value]
+    } else {
+        lappend moves $option $value
+    }
+    request
+}
+
+# One wheel step in (delta > 0) or out.
+proc ::pvr::gui::view::wheel {delta} {
+    variable zoomStep
+    if {$delta == 0} {
+        return
+    }
+    move -zoom [expr {$delta > 0 ? $zoomStep : 1.0 / $zoomStep}]
+}
+
+# Middle-button drag: the image follows the pointer, so the camera moves
+# the other way, in fractions of the widget's size.
+proc ::pvr::gui::view::panStart {x y} {
+    variable panFrom
+    set panFrom [list $x $y]
+}
+
+proc ::pvr::gui::view::panMotion {w x y} {
+    variable panFrom
+    if {![info exists panFrom] || $panFrom eq {}} {
+        set panFrom [list $x $y]
+        return
+    }
+    lassign $panFrom x0 y0
+    set panFrom [list $x $y]
+    set width [expr {max(1, [winfo width $w])}]
+    set height [expr {max(1, [winfo height $w])}]
+    if {$x == $x0 && $y == $y0} {
+        return
+    }
+    move -pan [format %.6f,%.6f [expr {-($x - $x0) / double($width)}] [expr {($y - $y0) / double($height)}]]
+}
+
+proc ::pvr::gui::view::panEnd {w x y} {
+    variable panFrom
+    panMotion $w $x $y
+    set panFrom {}
+}
+
+# ::pvr::gui::view::orbitWords --
+#   The `:s set` words that turn the server's camera to the orbit's view,
+#   or {} when it is the reported camera's own.
+proc ::pvr::gui::view::orbitWords {} {
+    variable base
+    variable azimuth
+    variable elevation
+    variable baseElevation
+    if {$base eq {} || ($azimuth == 0 && $elevation == $baseElevation)} {
+        return {}
+    }
+    return [list -elevation [expr {$elevation - $baseElevation}] -azimuth $azimuth]
+}
+
+# ::pvr::gui::view::commit --
+#   Makes the server's camera the view on screen (before a sequence): sets
+#   the orbit on the server; the next request reads the camera again.
+proc ::pvr::gui::view::commit {} {
+    variable base
+    variable setter
+    set words [orbitWords]
+    if {$words ne {} && $setter ne {}} {
+        uplevel #0 [concat $setter $words]
+        set base {}
+    }
 }
 
 proc ::pvr::gui::view::dragStart {x y} {
@@ -243,14 +353,9 @@ proc ::pvr::gui::view::turn {dAzimuth dElevation} {
 }
 
 # ::pvr::gui::view::reset --
-#   Back to the reported camera, and a frame.
+#   Back to the automatic camera (`-camera reset`), and a frame.
 proc ::pvr::gui::view::reset {} {
-    variable azimuth
-    variable elevation
-    variable baseElevation
-    set azimuth 0.0
-    set elevation $baseElevation
-    request
+    move -camera reset
 }
 
 # ::pvr::gui::view::sceneChanged --
@@ -284,6 +389,17 @@ proc ::pvr::gui::view::request {} {
     set dirty 0
     set busy 1
     if {[catch {
+        variable moves
+        variable setter
+        if {$moves ne {} && $setter ne {}} {
+            # The orbit first, then the moves, from the view on screen; a
+            # reset or a standard view replaces it (pvrsh drops moves before
+            # -camera reset), and the camera is read again.
+            set words $moves
+            set moves {}
+            uplevel #0 [concat $setter [orbitWords] $words]
+            set base {}
+        }
         if {$base eq {} && $cameraSource ne {}} {
             set camera [uplevel #0 $cameraSource]
             if {[llength $camera] == 3} {

@@ -19,12 +19,15 @@
 #   7. the cluster and group window shows the layout, asks the server for
 #      memory per cluster, applies the form, and its Strategy box offers
 #      exactly the server's strategies, each of which renders without error;
+#   5b. the mouse wheel zooms and the middle button pans the server's
+#      camera, the +z button looks down z, Reset returns the automatic
+#      camera; a screenshot of the screen shows the frame;
 #   8. the time slider
 #      is hidden for a single volume and shown for a series of 3 steps;
 #      moving it sets the session's step and renders a new frame.
 # Writes DIR/gui_frame.png (the photo) and DIR/gui_screenshot.png (the whole
 # screen, when ImageMagick's import is installed). Exits 0 when all pass, 1
-# otherwise; gives up after 80 s.
+# otherwise; gives up after 100 s.
 
 package require Tk
 
@@ -67,8 +70,8 @@ proc finish {} {
     exit [expr {$::failures == 0 ? 0 : 1}]
 }
 
-after 80000 {
-    puts "FAIL timeout: the GUI test did not finish in 80 s"
+after 100000 {
+    puts "FAIL timeout: the GUI test did not finish in 100 s"
     incr ::failures
     finish
 }
@@ -83,6 +86,15 @@ proc waitFor {condition seconds} {
         }
         after 20 {set ::tick 1}
         vwait ::tick
+    }
+    return 1
+}
+
+# pvrtest_near: number lists A and B agree within 1e-9 element by element.
+proc pvrtest_near {a b} {
+    if {[llength $a] != [llength $b]} { return 0 }
+    foreach x $a y $b {
+        if {abs($x - $y) > 1e-9} { return 0 }
     }
     return 1
 }
@@ -138,7 +150,7 @@ close $f
 set env(OMPI_ALLOW_RUN_AS_ROOT) 1
 set env(OMPI_ALLOW_RUN_AS_ROOT_CONFIRM) 1
 # `timeout` ends pvrd even when this script is killed before finish runs.
-set pvrdChan [open |[list timeout --signal=TERM 110 $arg(-pvrd) --listen 127.0.0.1:0 --data-dir $data --node $arg(-node) --max-ranks 2 2>@stderr] r]
+set pvrdChan [open |[list timeout --signal=TERM 130 $arg(-pvrd) --listen 127.0.0.1:0 --data-dir $data --node $arg(-node) --max-ranks 2 2>@stderr] r]
 fconfigure $pvrdChan -blocking 0 -buffering line
 set port ""
 proc readPvrd {} {
@@ -285,6 +297,108 @@ for {set y 0} {$y < 128} {incr y} {
 rename :ref {}
 check "button: the frame equals the reported camera turned, rendered by another session" {$worst <= 2} \
     "differs by $worst/255"
+
+# ---- Step 5b: wheel zoom, middle-button pan, standard views ----
+# Camera moves go to the server (`:s set -zoom/-pan/-view`), which applies
+# them to the camera in force; the orbit on screen is committed first.
+proc tanHalf {deg} { expr {tan($deg * acos(-1) / 360.0)} }
+proc minus {a b} { lmap x $a y $b {expr {$x - $y}} }
+set session $::pvr::gui::session
+set camBefore [$session camera]
+set litBefore [lit]
+set sentBefore $::pvr::gui::view::sent
+event generate $img <Button-4> -x 64 -y 64
+event generate $img <Button-4> -x 64 -y 64
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+set camZoomed [$session camera]
+check "wheel: two steps in zoom 1.25^2 on the server's camera" \
+    {abs([tanHalf [dict get $camBefore fov_y_deg]] / [tanHalf [dict get $camZoomed fov_y_deg]] - 1.5625) < 1e-9} \
+    "fov [dict get $camBefore fov_y_deg] -> [dict get $camZoomed fov_y_deg]"
+check "wheel: the orbit on screen became the server's camera" \
+    {[dict get $camZoomed automatic] == 0 && $::pvr::gui::view::azimuth == 0} "camera $camZoomed"
+set litZoomed [lit]
+check "wheel: the volume covers more pixels" {$litZoomed > $litBefore} "lit $litBefore -> $litZoomed"
+set sentBefore $::pvr::gui::view::sent
+event generate $img <MouseWheel> -delta -120 -x 64 -y 64
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+set camOut [$session camera]
+check "mouse wheel delta < 0: zooms out by 1.25" \
+    {abs([tanHalf [dict get $camOut fov_y_deg]] / [tanHalf [dict get $camZoomed fov_y_deg]] - 1.25) < 1e-9}
+set framePanFrom [pixels]
+set sentBefore $::pvr::gui::view::sent
+event generate $img <ButtonPress-2> -x 64 -y 64 -button 2
+for {set i 1} {$i <= 8} {incr i} {
+    event generate $img <B2-Motion> -x [expr {64 + 4 * $i}] -y 64 -state 0x200
+}
+event generate $img <ButtonRelease-2> -x 96 -y 64 -button 2 -state 0x200
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+set camPanned [$session camera]
+set eyeMoved [minus [dict get $camPanned eye] [dict get $camOut eye]]
+set lookMoved [minus [dict get $camPanned look_at] [dict get $camOut look_at]]
+check "middle drag: eye and look_at moved together" \
+    {[::pvr::gui::view::dot $lookMoved $lookMoved] > 1e-6 && [pvrtest_near $eyeMoved $lookMoved]} \
+    "eye by $eyeMoved, look_at by $lookMoved"
+check "middle drag: a new frame" {[pixels] ne $framePanFrom}
+# The image follows the pointer: dragged 20 pixels left (back towards the
+# middle, so that nothing is cut off at the edge), the lit pixels' mean
+# column moves 20 pixels left.
+proc litCentreX {} {
+    set sum 0.0
+    set n 0
+    for {set y 0} {$y < 128} {incr y 2} {
+        for {set x 0} {$x < 128} {incr x 2} {
+            lassign [$::photo get $x $y] r g b
+            if {$r + $g + $b > 60} {
+                set sum [expr {$sum + $x}]
+                incr n
+            }
+        }
+    }
+    return [expr {$n ? $sum / $n : -1}]
+}
+set sentBefore $::pvr::gui::view::sent
+set centreBefore [litCentreX]
+event generate $img <ButtonPress-2> -x 60 -y 64 -button 2
+event generate $img <B2-Motion> -x 40 -y 64 -state 0x200
+event generate $img <ButtonRelease-2> -x 40 -y 64 -button 2 -state 0x200
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+set centreAfter [litCentreX]
+check "middle drag left by 20 pixels: the volume moves left by about 20" \
+    {abs($centreAfter - $centreBefore + 20) < 4} "centre x $centreBefore -> $centreAfter"
+set sentBefore $::pvr::gui::view::sent
+.ctl.view.std.v+z invoke
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+set camTop [$session camera]
+set dir [minus [dict get $camTop look_at] [dict get $camTop eye]]
+set dirLength [expr {sqrt([::pvr::gui::view::dot $dir $dir])}]
+check "view button +z: looks along +z with up +y" \
+    {abs([lindex $dir 2] / $dirLength - 1) < 1e-9 && [dict get $camTop up] eq {0 1 0}} "camera $camTop"
+update
+if {[auto_execok import] ne ""} {
+    # The screen shows the frame: the lit pixels of the screenshot's image
+    # area are those of the photo.
+    set shot [file join $arg(-out) gui_camera_screenshot.png]
+    exec import -window root $shot
+    set shotPhoto [image create photo -file $shot]
+    set x0 [winfo rootx $img]
+    set y0 [winfo rooty $img]
+    set worst 0
+    for {set y 0} {$y < 128} {incr y 4} {
+        for {set x 0} {$x < 128} {incr x 4} {
+            foreach p [$photo get $x $y] q [$shotPhoto get [expr {$x0 + $x}] [expr {$y0 + $y}]] {
+                set worst [expr {max($worst, abs($p - $q))}]
+            }
+        }
+    }
+    check "screenshot: the view on screen is the top view's frame" {$worst <= 2} "differs by $worst/255"
+} else {
+    puts "note: ImageMagick's import is not installed: no screenshot check"
+}
+set sentBefore $::pvr::gui::view::sent
+.ctl.view.reset invoke
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+set camReset [$session camera]
+check "Reset: the automatic camera again" {[dict get $camReset automatic] == 1} "camera $camReset"
 
 # ---- Step 6: drag a transfer-function point ----
 set editor .ctl.tf.editor
