@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "cache_cluster.h"
+#include "data_summary.h"
 #include "decompose/content.h"
 #include "io/data_directory.h"
 #include "scene_volume.h"
@@ -70,18 +71,40 @@ void distributeStep(NodeState& state, int step) {
   state.pendingDist += secondsSince(start) - (state.pendingRead + state.pendingPreprocess - charged);
 }
 
+// Whether my brick counts towards the histogram: the bricks of one render
+// cluster (the first) cover the volume once; other clusters hold it again.
+bool countsForHistogram(const NodeState& state) {
+  if (!state.renders()) return false;
+  for (std::size_t c = 0; c < state.layout.clusters.size(); ++c)
+    if (state.layout.clusters[c].role == proto::ClusterRole::kRender) return int(c) == state.cluster;
+  return false;
+}
+
+// Local: a transfer function the scene left to the data (automatic, or a
+// preset to stretch) takes the data's range, and the bricks are classified
+// again, once the range is known.
+void applyDataDefaults(NodeState& state) {
+  core::TransferFunctionSpec& tf = state.scene.volumes.front().transfer;
+  if (!state.valueRange || !(tf.automatic || tf.rescaleToData)) return;
+  core::resolveDataDefaults(tf, (*state.valueRange)[0], (*state.valueRange)[1]);
+  classify(state);
+}
+
 // Collective over the world, after a phase that may have failed on this
-// rank: every rank learns the data's value range (of the bricks on
-// screen), then a rank that failed throws.
+// rank: every rank learns the data's value range and histogram (of the
+// bricks on screen), then a rank that failed throws; else the data's
+// defaults are applied.
 void agreeOnValueRange(NodeState& state, const std::optional<comm::Failure>& failure) {
-  // Max of (-min, max) over the ranks that hold a brick.
-  constexpr double kNone = -std::numeric_limits<double>::infinity();
-  std::vector<double> range{kNone, kNone};
-  if (state.current) range = {-state.current->brick.valueRange().min, state.current->brick.valueRange().max};
-  state.world.allReduceMax(range);
+  const core::Brick* brick = state.current ? &state.current->brick : nullptr;
+  const std::optional<DataSummary> summary = summarizeData(state.world, brick, countsForHistogram(state));
   state.valueRange.reset();
-  if (range[1] > kNone) state.valueRange = std::array<double, 2>{-range[0], range[1]};
+  state.histogram.clear();
+  if (summary) {
+    state.valueRange = summary->range;
+    state.histogram = summary->histogram;
+  }
   if (failure) throw comm::FailureError(*failure);
+  applyDataDefaults(state);
 }
 
 void collectFailure(NodeState& state, const std::function<void()>& phase) {
@@ -129,6 +152,10 @@ Reload openScene(NodeState& state, const std::string& sceneJson) {
   const bool stepChanged = scene.volumes.front().source.timestep != state.scene.volumes.front().source.timestep;
   state.scene = scene;
   state.renderOptions = options;
+  // The same volume: its range is known, so is a transfer function left to
+  // it (the caller classifies); a new volume's waits for loadBricks.
+  core::TransferFunctionSpec& tf = state.scene.volumes.front().transfer;
+  if (!changed && state.valueRange) core::resolveDataDefaults(tf, (*state.valueRange)[0], (*state.valueRange)[1]);
   const bool ghostChanged = ghost != state.ghost;
   state.ghost = ghost;
   if (changed || (ghostChanged && state.current)) return Reload::kAll;

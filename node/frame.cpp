@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "camera.h"
+#include "data_summary.h"
 #include "raycast/raycaster.h"
 #include "scene_volume.h"
 #include "thread_pool.h"
@@ -102,6 +103,10 @@ PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& optio
   const core::LoadTimes& loaded = prepared.bricks.brick.loadTimes();
   report.read = loaded.read;
   report.dist = std::max(0.0, secondsSince(distStart) - loaded.read - loaded.preprocess);
+
+  // A transfer function left to the data takes the whole volume's range.
+  const std::optional<DataSummary> summary = summarizeData(comm, &prepared.bricks.brick, true);
+  if (summary) core::resolveDataDefaults(result.scene.volumes.front().transfer, summary->range[0], summary->range[1]);
 
   // Preprocess (macrocell grid, classification) and render my brick into
   // its screen rectangle.

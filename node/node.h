@@ -114,6 +114,9 @@ struct NodeState {
   // The data's finite values, min and max over every brick; set by every
   // (re)distribution (loadBricks), on every rank.
   std::optional<std::array<double, 2>> valueRange;
+  // Its histogram, core::kHistogramBins bins over valueRange (data_summary.h),
+  // counted over the first render cluster's bricks; empty without data.
+  std::vector<std::uint64_t> histogram;
 
   // The wave in flight.
   std::vector<WaveFrame> wave;

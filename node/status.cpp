@@ -51,6 +51,19 @@ std::string decompositionNames() {
   return out;
 }
 
+// The dataset's grid, scalar type and histogram (data_summary.h): what
+// `:s info` answers and the GUI's transfer-function editor draws.
+void addGrid(const NodeState& state, std::vector<proto::KeyValue>& out) {
+  const core::GridGeometry& grid = state.source->grid();
+  out.push_back({"dims", list({double(grid.dims.x), double(grid.dims.y), double(grid.dims.z)})});
+  out.push_back({"spacing", list(grid.spacing)});
+  out.push_back({"origin", list(grid.origin)});
+  out.push_back({"dtype", std::string(core::scalarName(state.source->type()))});
+  std::string bins;
+  for (std::uint64_t n : state.histogram) append(bins, std::to_string(n));
+  out.push_back({"histogram", bins});
+}
+
 // The keys that describe the loaded dataset as it is rendered.
 void addDataset(const NodeState& state, std::vector<proto::KeyValue>& out) {
   const core::CameraSpec& camera = state.scene.camera;  // resolved: the automatic camera is filled in
@@ -65,6 +78,7 @@ void addDataset(const NodeState& state, std::vector<proto::KeyValue>& out) {
   const core::GridGeometry& grid = state.source->grid();
   const core::Vec3 lo = grid.domainMin(), hi = grid.domainMax();
   out.push_back({"bounds", list({lo.x, lo.y, lo.z, hi.x, hi.y, hi.z})});
+  addGrid(state, out);
   if (state.valueRange) out.push_back({"value_range", list({(*state.valueRange)[0], (*state.valueRange)[1]})});
   std::string points;
   for (const core::TransferPoint& p : state.scene.volumes.front().transfer.points)

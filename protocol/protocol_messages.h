@@ -90,12 +90,22 @@ struct FrameTiming {
 };
 static_assert(sizeof(FrameTiming) == kFrameTimingBytes, "FrameTiming's wire size is kFrameTimingBytes");
 
-// One dataset of the catalog: its name relative to the data directory and
-// its number of time steps (1 for a single volume).
+// One dataset of the catalog, listed once under its stem ("head" for
+// head.json and head.nhdr): its name relative to the data directory, its
+// number of time steps (1 for a single volume), the file it opens from,
+// the format's name, its dims and scalar type, and why it cannot be loaded
+// (empty when it can; dims 0 0 0 and dtype empty then).
 struct CatalogEntry {
   std::string name;
   std::uint32_t steps = 1;
-  static auto fields(auto& self) { return std::tie(self.name, self.steps); }
+  std::string file;
+  std::string format;
+  std::array<std::uint32_t, 3> dims{0, 0, 0};
+  std::string dtype;
+  std::string note;
+  static auto fields(auto& self) {
+    return std::tie(self.name, self.steps, self.file, self.format, self.dims, self.dtype, self.note);
+  }
   bool operator==(const CatalogEntry&) const = default;
 };
 

@@ -30,17 +30,40 @@ bool inside(const std::string& root, const std::string& path) {
          (root == "/" || path[root.size()] == '/');
 }
 
-// "STEPS<TAB>NAME" with STEPS a positive 32-bit count, as node/catalog_listing.cpp prints it.
-bool parseEntry(const std::string& line, proto::CatalogEntry& entry) {
-  const std::size_t tab = line.find('\t');
-  if (tab == 0 || tab == std::string::npos || tab > 10 || tab + 1 == line.size()) return false;
-  std::uint64_t steps = 0;
-  for (std::size_t i = 0; i < tab; ++i) {
-    if (line[i] < '0' || line[i] > '9') return false;
-    steps = steps * 10 + std::uint64_t(line[i] - '0');
+// A non-negative 32-bit decimal count, all of `text`.
+bool parseCount(const std::string& text, std::uint32_t& out) {
+  if (text.empty() || text.size() > 10) return false;
+  std::uint64_t n = 0;
+  for (char c : text) {
+    if (c < '0' || c > '9') return false;
+    n = n * 10 + std::uint64_t(c - '0');
   }
-  if (steps == 0 || steps > UINT32_MAX) return false;
-  entry = {line.substr(tab + 1), std::uint32_t(steps)};
+  if (n > UINT32_MAX) return false;
+  out = std::uint32_t(n);
+  return true;
+}
+
+// "STEPS<TAB>NAME<TAB>FILE<TAB>FORMAT<TAB>X<TAB>Y<TAB>Z<TAB>DTYPE<TAB>NOTE"
+// with STEPS positive, as node/catalog_listing.cpp prints it.
+bool parseEntry(const std::string& line, proto::CatalogEntry& entry) {
+  std::vector<std::string> f;
+  for (std::size_t at = 0;;) {
+    const std::size_t tab = line.find('\t', at);
+    f.push_back(line.substr(at, tab == std::string::npos ? std::string::npos : tab - at));
+    if (tab == std::string::npos) break;
+    at = tab + 1;
+  }
+  if (f.size() != 9 || f[1].empty() || f[2].empty()) return false;
+  proto::CatalogEntry e;
+  if (!parseCount(f[0], e.steps) || e.steps == 0) return false;
+  for (int a = 0; a < 3; ++a)
+    if (!parseCount(f[4 + std::size_t(a)], e.dims[std::size_t(a)])) return false;
+  e.name = f[1];
+  e.file = f[2];
+  e.format = f[3];
+  e.dtype = f[7];
+  e.note = f[8];
+  entry = std::move(e);
   return true;
 }
 

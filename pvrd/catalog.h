@@ -22,7 +22,8 @@ namespace pvr::daemon {
 // the session does not relay meanwhile.
 inline constexpr double kCatalogSeconds = 20;
 
-// Runs `nodePath --catalog dataDir` and parses its "STEPS<TAB>NAME" lines.
+// Runs `nodePath --catalog dataDir` and parses its dataset lines
+// (node/catalog_listing.h, printCatalog).
 // Its other lines (files it left out and why) go to `note`. Returns the
 // entries in the program's order (sorted by name), or the error for the
 // client: kIo when the program cannot start, fails or prints a malformed

@@ -14,6 +14,7 @@
 #include "admission.h"
 #include "auth.h"
 #include "catalog.h"
+#include "dataset_names.h"
 #include "connect_back.h"
 #include "launcher.h"
 #include "out_buffer.h"
@@ -78,6 +79,9 @@ class Session {
   void endConnection(ErrorCode code, const std::string& text, std::uint32_t id);
   void onClient(proto::Decoded frame);
   void openSession(const proto::SessionOpen& open, std::uint32_t id);
+  // A dataset named by its catalog stem: the real path of the entry's file,
+  // or kDatasetNotFound suggesting the closest names (dataset_names.h).
+  std::variant<std::string, proto::ProtocolError> resolveStem(const std::string& name);
   void onMaster(proto::RelayItem item);
   // Plaintext for the master, through its secure channel.
   void writeMaster(std::span<const std::uint8_t> plain);
@@ -290,6 +294,8 @@ void Session::onClient(proto::Decoded frame) {
   if (!launcher_) return replyError(ErrorCode::kUnexpectedMessage, "open a session first", id);
   if (const auto* scene = std::get_if<proto::SetScene>(&m); scene && !scene->dataset.empty()) {
     auto resolved = resolveDataset(opt_.dataDir, scene->dataset);
+    if (auto* err = std::get_if<proto::ProtocolError>(&resolved); err && err->code == ErrorCode::kDatasetNotFound)
+      resolved = resolveStem(scene->dataset);
     if (auto* err = std::get_if<proto::ProtocolError>(&resolved)) {
       log("refused dataset '" + scene->dataset + "': " + err->text);
       return replyError(err->code, err->text, id);
@@ -300,6 +306,15 @@ void Session::onClient(proto::Decoded frame) {
       std::holds_alternative<proto::RenderTimeSteps>(m))
     rendering_.insert(id);
   forward(m, id);
+}
+
+std::variant<std::string, proto::ProtocolError> Session::resolveStem(const std::string& name) {
+  auto listed = listDatasets(cfg_.nodePath, opt_.dataDir, kCatalogSeconds,
+                             [this](const std::string& note) { log("catalog: " + note); });
+  if (auto* err = std::get_if<proto::ProtocolError>(&listed)) return *err;
+  const auto& catalog = std::get<std::vector<proto::CatalogEntry>>(listed);
+  if (const auto file = fileOfStem(catalog, name)) return resolveDataset(opt_.dataDir, *file);
+  return proto::ProtocolError{ErrorCode::kDatasetNotFound, unknownDatasetText(name, catalog)};
 }
 
 void Session::openSession(const proto::SessionOpen& open, std::uint32_t id) {

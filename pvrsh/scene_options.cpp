@@ -38,6 +38,7 @@ struct Apply {
   const std::string& option;  // "-imagesz"
   const std::string& value;   // as given
   const ServerNames& serverNames;
+  bool absolute = false;  // -tfpreset only: "-absolute" followed its value
 
   void scene(const json& patch) {
     mergeKeepingNulls(change.patch, patch);
@@ -122,7 +123,7 @@ void setBackground(Apply& a) {
 // A transfer function has exactly one source (docs/scene.md): setting one
 // deletes the others, so a merge patch never leaves two behind.
 json transferSource(const char* key, json value) {
-  json tf = {{"points", nullptr}, {"paraview_preset", nullptr}, {"paraview", nullptr}};
+  json tf = {{"points", nullptr}, {"paraview_preset", nullptr}, {"paraview", nullptr}, {"absolute", nullptr}};
   tf[key] = std::move(value);
   return {{"transfer_function", tf}};
 }
@@ -151,7 +152,11 @@ void setTransferPreset(Apply& a) {
   json preset = json::parse(text, nullptr, false);
   if (preset.is_discarded()) argsError("TFPRESET", "-tfpreset: " + a.value + " is not JSON");
   if (!preset.is_array()) preset = json::array({std::move(preset)});
-  a.scene(transferSource("paraview", std::move(preset)));
+  json patch = transferSource("paraview", std::move(preset));
+  // The server stretches a preset onto the data's range unless told its
+  // scalars are absolute (applyOptions reads the -absolute flag).
+  if (a.absolute) patch["transfer_function"]["absolute"] = true;
+  a.scene(std::move(patch));
 }
 
 // -camera auto|reset: back to the automatic camera; moves given before it
@@ -278,15 +283,18 @@ SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tc
     const std::string option = kOptions[index].name;
     if (i + 1 >= objc) argsError("VALUE", "value for \"" + option + "\" missing");
     const std::string value = Tcl_GetString(objv[i + 1]);
+    // "-tfpreset FILE -absolute": a flag, the one option word without a value.
+    const bool absolute = option == "-tfpreset" && i + 2 < objc && std::string_view(Tcl_GetString(objv[i + 2])) == "-absolute";
     if (option == "-cluster") {
       cluster = value;
     } else if (option == "-group") {
       group = value;
     } else {
-      Apply a{next, change, option, value, serverNames};
+      Apply a{next, change, option, value, serverNames, absolute};
       kOptions[index].apply(a);
     }
-    remember(next, option, value);
+    remember(next, option, absolute ? value + " -absolute" : value);
+    if (absolute) ++i;
   }
   if (cluster || group) {
     // Figure 5: "-cluster r,16 -group 0,0,1,1" is four render clusters of 16

@@ -83,6 +83,8 @@ class Session : public Connection::Listener {
   // The camera in force as a dict (automatic, projection, eye, look_at, up,
   // fov_y_deg or height); errors when the server cannot say now.
   Tcl_Obj* cameraObj();
+  // `:s info`: the loaded dataset's grid, type, range and histogram (session_info.cpp).
+  Tcl_Obj* infoObj();
   Tcl_Obj* timingObj() const;
   // Throws {PVR STATE NOTOPEN} naming `what` unless the session is open.
   void requireOpen(const char* what) const;

@@ -149,9 +149,20 @@ int imageCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   return TCL_OK;
 }
 
-// :s list status | :s list datasets ?-steps?
-// Datasets: the catalog's names; with -steps a dictionary of name -> number
-// of time steps (1 for a single volume), in catalog order.
+// :s info: the loaded dataset's dims, spacing, origin, bounds, dtype, range, histogram.
+int infoCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc != 2) {
+    Tcl_WrongNumArgs(interp, 2, objv, "");
+    return TCL_ERROR;
+  }
+  Tcl_SetObjResult(interp, s.infoObj());
+  return TCL_OK;
+}
+
+// :s list status | :s list datasets ?-steps|-details?
+// Datasets: the catalog's names (stems); with -steps a dictionary of name
+// -> number of time steps (1 for a single volume), with -details name ->
+// dict {file format dims dtype steps note}, in catalog order.
 int listCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   static const char* const kWhat[] = {"datasets", "status", nullptr};
   if (objc != 3 && objc != 4) {
@@ -161,21 +172,32 @@ int listCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   int what = 0;
   if (Tcl_GetIndexFromObj(interp, objv[2], kWhat, "list", 0, &what) != TCL_OK)
     throw TclError({"PVR", "ARGS", "LIST"}, Tcl_GetStringResult(interp));
-  if (objc == 4 && (what == 1 || str(objv[3]) != "-steps"))
-    argsError("LIST", "bad option \"" + str(objv[3]) + "\": " +
-                          (what == 1 ? "list status takes no option" : "list datasets takes only -steps"));
+  const std::string flag = objc == 4 ? str(objv[3]) : "";
+  if (objc == 4 && (what == 1 || (flag != "-steps" && flag != "-details")))
+    argsError("LIST", "bad option \"" + flag + "\": " +
+                          (what == 1 ? "list status takes no option" : "list datasets takes -steps or -details"));
   if (what == 1) {
     Tcl_SetObjResult(interp, s.statusObj());
     return TCL_OK;
   }
   s.requireOpen("list datasets");
-  const bool withSteps = objc == 4;
   Tcl_Obj* list = Tcl_NewListObj(0, nullptr);
+  const auto text = [](const std::string& v) { return Tcl_NewStringObj(v.data(), int(v.size())); };
   for (const auto& m : s.query(proto::CatalogRequest{}, 30))
     if (const auto* c = std::get_if<proto::CatalogReply>(&m))
       for (const auto& entry : c->datasets) {
-        Tcl_ListObjAppendElement(nullptr, list, Tcl_NewStringObj(entry.name.c_str(), -1));
-        if (withSteps) Tcl_ListObjAppendElement(nullptr, list, Tcl_NewWideIntObj(Tcl_WideInt(entry.steps)));
+        Tcl_ListObjAppendElement(nullptr, list, text(entry.name));
+        if (flag == "-steps") Tcl_ListObjAppendElement(nullptr, list, Tcl_NewWideIntObj(Tcl_WideInt(entry.steps)));
+        if (flag != "-details") continue;
+        Tcl_Obj* d = Tcl_NewDictObj();
+        Tcl_Obj* dims[3] = {Tcl_NewWideIntObj(entry.dims[0]), Tcl_NewWideIntObj(entry.dims[1]),
+                            Tcl_NewWideIntObj(entry.dims[2])};
+        const std::pair<const char*, Tcl_Obj*> items[] = {
+            {"file", text(entry.file)},     {"format", text(entry.format)},
+            {"dims", Tcl_NewListObj(3, dims)}, {"dtype", text(entry.dtype)},
+            {"steps", Tcl_NewWideIntObj(Tcl_WideInt(entry.steps))}, {"note", text(entry.note)}};
+        for (const auto& [k, v] : items) Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj(k, -1), v);
+        Tcl_ListObjAppendElement(nullptr, list, d);
       }
   Tcl_SetObjResult(interp, list);
   return TCL_OK;
@@ -206,7 +228,7 @@ int setCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   }
   for (Tcl_Obj* o : words) Tcl_IncrRefCount(o);
   try {
-    if (words.size() % 2 != 0) argsError("VALUE", "value for \"" + str(words.back()) + "\" missing");
+    // An odd count is checked there: "-tfpreset FILE -absolute" has a flag.
     s.applySettings(applyOptions(interp, s.settings_, int(words.size()), words.data(),
                                  [&s](std::string_view key) { return s.serverNames(key); }));
   } catch (...) {
@@ -416,7 +438,8 @@ const Subcommand kSubcommands[] = {
     {"help", helpCmd, "?subcommand?", "this help; with a subcommand, its usage (and, for set, every option)"},
     {"image", imageCmd, "window|callback|file|dir ?value?",
      "where frames go: a Tk photo, a callback, numbered files or a directory (no value: the current one)"},
-    {"list", listCmd, "status|datasets ?-steps?", "the session's status, or the server's datasets"},
+    {"info", infoCmd, "", "the loaded dataset: dims, spacing, origin, bounds, dtype, range and histogram"},
+    {"list", listCmd, "status|datasets ?-steps|-details?", "the session's status, or the server's datasets"},
     {"notify", notifyCmd, "?command?", "call COMMAND event details... on done, cancelled and error"},
     {"open", openCmd, "host?:port? ?-ranks n? ?-account name? ?-token-file file? ?-timeout seconds?",
      "connect to pvrd (port 7350 by default) and start a job of N ranks"},

@@ -94,19 +94,23 @@ double Brick::valueAt(IVec3 node) const {
 
 void Brick::updateValueRange(ThreadPool* pool) {
   const auto start = std::chrono::steady_clock::now();
-  Preprocessed p = preprocessVoxels(type_, owned_, stored_, data_.data(), pool);
+  const NodeBox counted = countedBox(owned_, grid_);
+  Preprocessed p = preprocessVoxels(type_, owned_, stored_, data_.data(), pool, &counted);
   range_ = p.range;
   bounds_ = std::move(p.bounds);
+  histogram_ = std::move(p.histogram);
   loadTimes_.preprocess += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-void Brick::setPreprocessed(const ValueRange& range, std::shared_ptr<const MacrocellBounds> bounds) {
+void Brick::setPreprocessed(const ValueRange& range, std::shared_ptr<const MacrocellBounds> bounds,
+                            std::shared_ptr<const FineHistogram> histogram) {
   if (!bounds || bounds->type() != type_ || !(bounds->layout() == MacrocellLayout::forOwned(owned_)))
     throw Error(ErrorCode::kInternal, "brick " + toString(stored_) +
                                           ": macrocell bounds are not laid out for its owned box " +
                                           toString(owned_) + " and scalar type");
   range_ = range;
   bounds_ = std::move(bounds);
+  histogram_ = std::move(histogram);
 }
 
 Brick cropBrick(const Brick& source, const NodeBox& owned, int ghostLayers) {

@@ -15,6 +15,7 @@
 
 #include "grid.h"
 #include "macrocell_bounds.h"
+#include "value_histogram.h"
 
 namespace pvr::core {
 
@@ -59,6 +60,7 @@ class Brick {
   // match them); updateValueRange() computes them again.
   std::byte* bytes() {
     bounds_.reset();
+    histogram_.reset();
     return data_.data();
   }
   const std::byte* bytes() const { return data_.data(); }
@@ -78,15 +80,20 @@ class Brick {
   // One voxel as double; for tests, references and set-up, not for hot loops.
   double valueAt(IVec3 node) const;
 
-  // Recomputes the finite value range and the macrocell bounds from storage
-  // in one pass (preprocess.h), over `pool`'s threads when one is given,
+  // Recomputes the finite value range, the macrocell bounds and the fine
+  // histogram of the counted box (countedBox) from storage in one pass
+  // (preprocess.h), over `pool`'s threads when one is given,
   // the same result either way. Loaders call it after filling storage; its
   // seconds add to loadTimes().preprocess.
   void updateValueRange(ThreadPool* pool = nullptr);
   const ValueRange& valueRange() const { return range_; }
   // For readers that preprocessed the voxels as they landed. Throws if the
   // bounds are not laid out for this brick's owned box and scalar type.
-  void setPreprocessed(const ValueRange& range, std::shared_ptr<const MacrocellBounds> bounds);
+  void setPreprocessed(const ValueRange& range, std::shared_ptr<const MacrocellBounds> bounds,
+                       std::shared_ptr<const FineHistogram> histogram = nullptr);
+  // Fine counts of the voxels this brick counts (countedBox(owned, grid)),
+  // or null when storage was written since, or a reader gave none.
+  const std::shared_ptr<const FineHistogram>& fineHistogram() const { return histogram_; }
   // The macrocell bounds of the owned box, or null when storage was written
   // since they were computed (or they never were). Shared, never copied:
   // the renderer's MacrocellGrid holds the same object.
@@ -127,6 +134,7 @@ class Brick {
   std::vector<std::byte, UnwrittenAllocator<std::byte>> data_;
   ValueRange range_;
   std::shared_ptr<const MacrocellBounds> bounds_;
+  std::shared_ptr<const FineHistogram> histogram_;
   LoadTimes loadTimes_;
 };
 

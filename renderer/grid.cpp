@@ -41,6 +41,15 @@ ScalarType parseScalarType(std::string_view name, std::string_view where) {
   };
   for (const Alias& a : kAliases)
     if (a.name == name) return a.type;
+  // A real type this renderer does not render is unsupported, not a bad
+  // file: the catalog lists such a volume with a note (catalog_listing.h).
+  static constexpr std::string_view kKnown[] = {"float64", "double", "int8", "signed char", "char", "int32", "int",
+                                                "uint32", "unsigned int", "int64", "uint64", "longlong",
+                                                "ulonglong", "long long", "unsigned long long"};
+  for (std::string_view k : kKnown)
+    if (k == name)
+      throw Error(ErrorCode::kUnsupported, std::string(where) + ": unknown scalar type '" + std::string(name) +
+                                               "' (supported: uint8, uint16, int16, float32)");
   throw Error(ErrorCode::kBadFile, std::string(where) + ": unknown scalar type '" +
                                        std::string(name) +
                                        "' (supported: uint8, uint16, int16, float32)");

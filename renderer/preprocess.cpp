@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <type_traits>
+#include <mutex>
 #include <vector>
 
+#include "error.h"
 #include "thread_pool.h"
 
 namespace pvr::core {
@@ -59,6 +61,24 @@ std::uint64_t countNonFinite(const T* __restrict r, std::size_t n) {
   return bad;
 }
 
+// Adds the fine keys of a row's finite values to `counts`. Two tables
+// taken in turn keep consecutive equal values (flat regions, air) from
+// waiting on each other's increment.
+template <typename T>
+void countRow(const T* __restrict r, std::size_t n, std::uint64_t* __restrict a, std::uint64_t* __restrict b) {
+  std::size_t i = 0;
+  for (; i + 1 < n; i += 2) {
+    if constexpr (std::is_floating_point_v<T>) {
+      if ((r[i] - r[i]) == T(0)) ++a[fineKey(r[i])];
+      if ((r[i + 1] - r[i + 1]) == T(0)) ++b[fineKey(r[i + 1])];
+    } else {
+      ++a[fineKey(r[i])];
+      ++b[fineKey(r[i + 1])];
+    }
+  }
+  if (i < n && (r[i] - r[i]) == T(0)) ++a[fineKey(r[i])];
+}
+
 // Folds slabs into the macrocell layers [layerLo, layerHi) (relative to
 // layout.first.z) of `bounds`, and the slabs it is told to count into a
 // value range of its own.
@@ -66,9 +86,15 @@ template <typename T>
 class SlabAccumulator {
  public:
   SlabAccumulator(const NodeBox& stored, MacrocellBounds& bounds, std::int64_t layerLo,
-                  std::int64_t layerHi)
+                  std::int64_t layerHi, const NodeBox* counted)
       : st_(stored), l_(bounds.layout()), bounds_(bounds), layerLo_(layerLo), layerHi_(layerHi),
         ex_(std::size_t(stored.extent(0))) {
+    if (counted && !counted->empty()) {
+      counted_ = *counted;
+      const std::size_t keys = std::size_t(1) << (sizeof(T) == 1 ? 8 : 16);  // fineKeyCount
+      countsA_.assign(keys, 0);
+      countsB_.assign(keys, 0);
+    }
     groupMin_.resize(ex_);
     groupMax_.resize(ex_);
     rangeMin_.assign(ex_, emptyMin<T>());
@@ -125,6 +151,12 @@ class SlabAccumulator {
       }
     }
 
+    // Step: count the owned voxels' keys, each slab once (countRange).
+    if (countRange && !countsA_.empty() && z >= counted_.lo.z && z <= counted_.hi.z)
+      for (std::int64_t y = counted_.lo.y; y <= counted_.hi.y; ++y)
+        countRow(row(y) + std::size_t(counted_.lo.x - st_.lo.x), std::size_t(counted_.extent(0)), countsA_.data(),
+                 countsB_.data());
+
     // Step: widen the layers.
     if (into0) foldLayer(m0);
     if (into1) foldLayer(m1);
@@ -138,6 +170,11 @@ class SlabAccumulator {
       hi = greater(hi, rangeMax_[i]);
     }
     return {double(lo), double(hi), nonFinite_};
+  }
+
+  // Adds the counted keys to `out` (sized fineKeyCount); nothing without a counted box.
+  void addCounts(std::vector<std::uint64_t>& out) const {
+    for (std::size_t k = 0; k < countsA_.size(); ++k) out[k] += countsA_[k] + countsB_[k];
   }
 
  private:
@@ -156,6 +193,8 @@ class SlabAccumulator {
   std::vector<T> rangeMin_, rangeMax_;  // every counted row, reduced
   std::vector<T> slabMin_, slabMax_;    // this slab's 2-D macrocell bounds
   std::uint64_t nonFinite_ = 0;
+  NodeBox counted_;                                  // histogram box, when countsA_ is sized
+  std::vector<std::uint64_t> countsA_, countsB_;     // fine key counts, two tables (countRow)
 };
 
 ValueRange mergeRanges(const ValueRange& a, const ValueRange& b) {
@@ -175,15 +214,17 @@ struct SlabPreprocessor::Impl {
   virtual ~Impl() = default;
   virtual void add(const std::byte* voxels, std::int64_t z0, std::int64_t z1) = 0;
   virtual ValueRange range() const = 0;
+  virtual void addCounts(std::vector<std::uint64_t>& out) const = 0;
   std::shared_ptr<MacrocellBounds> bounds;
+  std::shared_ptr<FineHistogram> histogram;
 };
 
 namespace {
 
 template <typename T>
 struct TypedSlabPreprocessor final : SlabPreprocessor::Impl {
-  TypedSlabPreprocessor(const NodeBox& stored, std::shared_ptr<MacrocellBounds> b)
-      : acc(stored, *b, 0, b->layout().count.z),
+  TypedSlabPreprocessor(const NodeBox& stored, std::shared_ptr<MacrocellBounds> b, const NodeBox* counted)
+      : acc(stored, *b, 0, b->layout().count.z, counted),
         slabNodes(std::size_t(stored.extent(0) * stored.extent(1))) {
     bounds = std::move(b);
   }
@@ -192,18 +233,37 @@ struct TypedSlabPreprocessor final : SlabPreprocessor::Impl {
     for (std::int64_t z = z0; z <= z1; ++z, v += slabNodes) acc.addSlab(v, z, true);
   }
   ValueRange range() const override { return finalRange(acc.range()); }
+  void addCounts(std::vector<std::uint64_t>& out) const override { acc.addCounts(out); }
   SlabAccumulator<T> acc;
   std::size_t slabNodes;
 };
 
 }  // namespace
 
-SlabPreprocessor::SlabPreprocessor(ScalarType type, const NodeBox& owned, const NodeBox& stored) {
+namespace {
+
+std::shared_ptr<FineHistogram> emptyHistogram(ScalarType type, const NodeBox* counted, const NodeBox& stored) {
+  if (!counted) return nullptr;
+  if (!counted->empty() && !stored.contains(*counted))
+    throw Error(ErrorCode::kInternal, "preprocess: histogram box " + toString(*counted) +
+                                          " is not inside the stored box " + toString(stored));
+  auto h = std::make_shared<FineHistogram>();
+  h->type = type;
+  h->counts.assign(fineKeyCount(type), 0);
+  return h;
+}
+
+}  // namespace
+
+SlabPreprocessor::SlabPreprocessor(ScalarType type, const NodeBox& owned, const NodeBox& stored,
+                                   const NodeBox* counted) {
   auto bounds = std::make_shared<MacrocellBounds>(type, MacrocellLayout::forOwned(owned));
+  auto histogram = emptyHistogram(type, counted, stored);
   impl_ = dispatchScalar(type, [&](auto tag) -> std::unique_ptr<Impl> {
     using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
-    return std::make_unique<TypedSlabPreprocessor<T>>(stored, std::move(bounds));
+    return std::make_unique<TypedSlabPreprocessor<T>>(stored, std::move(bounds), counted);
   });
+  impl_->histogram = std::move(histogram);
 }
 
 SlabPreprocessor::~SlabPreprocessor() = default;
@@ -212,11 +272,15 @@ void SlabPreprocessor::add(const std::byte* voxels, std::int64_t z0, std::int64_
   impl_->add(voxels, z0, z1);
 }
 
-Preprocessed SlabPreprocessor::finish() { return {impl_->range(), std::move(impl_->bounds)}; }
+Preprocessed SlabPreprocessor::finish() {
+  if (impl_->histogram) impl_->addCounts(impl_->histogram->counts);
+  return {impl_->range(), std::move(impl_->bounds), std::move(impl_->histogram)};
+}
 
 Preprocessed preprocessVoxels(ScalarType type, const NodeBox& owned, const NodeBox& stored,
-                              const std::byte* voxels, ThreadPool* pool) {
+                              const std::byte* voxels, ThreadPool* pool, const NodeBox* counted) {
   Preprocessed out;
+  out.histogram = emptyHistogram(type, counted, stored);
   const MacrocellLayout layout = MacrocellLayout::forOwned(owned);
   out.bounds = std::make_shared<MacrocellBounds>(type, layout);
   const std::int64_t layers = layout.count.z;
@@ -236,11 +300,12 @@ Preprocessed preprocessVoxels(ScalarType type, const NodeBox& owned, const NodeB
     return (layout.first.z + layerAt(c)) * kSize;
   };
   std::vector<ValueRange> ranges(static_cast<std::size_t>(chunks));
+  std::mutex countsMutex;  // chunks add their key counts to out.histogram one at a time
   auto runChunk = [&](std::size_t c, int) {
     dispatchScalar(type, [&](auto tag) {
       using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
       const std::int64_t l0 = layerAt(std::int64_t(c)), l1 = layerAt(std::int64_t(c) + 1);
-      SlabAccumulator<T> acc(stored, *out.bounds, l0, l1);
+      SlabAccumulator<T> acc(stored, *out.bounds, l0, l1, counted);
       const std::int64_t cz0 = countFrom(std::int64_t(c)), cz1 = countFrom(std::int64_t(c) + 1) - 1;
       const std::int64_t bz0 = std::max(stored.lo.z, (layout.first.z + l0) * kSize);
       const std::int64_t bz1 = std::min(stored.hi.z, (layout.first.z + l1) * kSize);
@@ -248,6 +313,10 @@ Preprocessed preprocessVoxels(ScalarType type, const NodeBox& owned, const NodeB
       for (std::int64_t z = std::min(cz0, bz0); z <= std::max(cz1, bz1); ++z)
         acc.addSlab(v + std::size_t(z - stored.lo.z) * slabNodes, z, z >= cz0 && z <= cz1);
       ranges[c] = acc.range();
+      if (out.histogram) {
+        const std::lock_guard<std::mutex> lock(countsMutex);
+        acc.addCounts(out.histogram->counts);
+      }
     });
   };
   if (pool && chunks > 1) pool->parallelFor(std::size_t(chunks), runChunk);

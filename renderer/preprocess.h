@@ -9,7 +9,9 @@
 // holds the slab. A slab's few rows stay in cache while all of this
 // happens, so a reader can hand each slab over right after it lands and
 // the data is touched once (raw_reader.cpp). Float data skips NaN and Inf
-// in both range and bounds, and counts them.
+// in both range and bounds, and counts them. The same pass counts the
+// histogram's fine keys of the voxels a brick owns (value_histogram.h):
+// one table increment per owned voxel, nothing per ghost.
 #pragma once
 
 #include <cstdint>
@@ -17,6 +19,7 @@
 
 #include "brick.h"
 #include "macrocell_bounds.h"
+#include "value_histogram.h"
 
 namespace pvr::core {
 
@@ -25,13 +28,19 @@ class ThreadPool;
 struct Preprocessed {
   ValueRange range;
   std::shared_ptr<MacrocellBounds> bounds;
+  // Fine counts of the voxels in the box the caller named (value_histogram.h);
+  // null when it named none.
+  std::shared_ptr<FineHistogram> histogram;
 };
 
 // Takes a brick's node slabs one or a few at a time, in any order, each
 // once; single-threaded. For readers that fill a brick slab by slab.
 class SlabPreprocessor {
  public:
-  SlabPreprocessor(ScalarType type, const NodeBox& owned, const NodeBox& stored);
+  // `counted`, when given, is the box whose voxels the histogram counts
+  // (countedBox of the owned box); it must lie inside `stored`.
+  SlabPreprocessor(ScalarType type, const NodeBox& owned, const NodeBox& stored,
+                   const NodeBox* counted = nullptr);
   ~SlabPreprocessor();
   SlabPreprocessor(const SlabPreprocessor&) = delete;
   SlabPreprocessor& operator=(const SlabPreprocessor&) = delete;
@@ -51,7 +60,9 @@ class SlabPreprocessor {
 
 // The whole stored box at once, over the pool's threads when one is given
 // (chunks of macrocell layers); the result does not depend on the threads.
+// With `counted`, also the fine histogram of that box, as SlabPreprocessor.
 Preprocessed preprocessVoxels(ScalarType type, const NodeBox& owned, const NodeBox& stored,
-                              const std::byte* voxels, ThreadPool* pool = nullptr);
+                              const std::byte* voxels, ThreadPool* pool = nullptr,
+                              const NodeBox* counted = nullptr);
 
 }  // namespace pvr::core

@@ -37,6 +37,8 @@ Scene parseScene(const json& doc, const std::string& baseDir) {
   if (const json* v = find(doc, "camera")) scene.camera = parseCameraSection(*v);
   if (const json* v = find(doc, "image")) scene.image = parseImage(*v);
   if (const json* v = find(doc, "sampling")) scene.sampling = parseSampling(*v);
+  // Without "shading.enabled" the data decides (resolveDefaults).
+  scene.shading.automatic = true;
   if (const json* v = find(doc, "shading")) scene.shading = parseShading(*v);
   return scene;
 }
@@ -58,7 +60,8 @@ json sceneToJson(const Scene& s) {
   json doc;
   if (s.volumes.size() == 1 && first.name == SceneVolume{}.name && first.visible) {
     doc["volume"] = volumeToJson(first.source);
-    doc["transfer_function"] = transferToJson(first.transfer);
+    // A transfer function left to the data is the absent section.
+    if (!first.transfer.automatic) doc["transfer_function"] = transferToJson(first.transfer);
   } else {
     doc["volumes"] = volumesToJson(s.volumes);
   }

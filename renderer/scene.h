@@ -46,6 +46,14 @@ struct TransferFunctionSpec {
   // World length over which `opacity` applies. 0 means "one voxel": the
   // grid's smallest spacing, resolved when the volume is known.
   double unitDistance = 0;
+  // The scene gave no transfer function: `points` is a placeholder until
+  // the data's value range is known, then a white ramp over it
+  // (resolveDataDefaults).
+  bool automatic = false;
+  // A ParaView preset without "absolute": true: its points' scalars are
+  // stretched from their own span onto the data's value range when that is
+  // known (resolveDataDefaults), as ParaView applies a preset.
+  bool rescaleToData = false;
 };
 
 enum class Projection { kOrthographic, kPerspective };
@@ -99,6 +107,11 @@ struct ShadingSpec {
   // Light direction in camera space (x right, y up, z towards the viewer);
   // (0,0,1) is the headlight.
   Vec3 lightDirection{0, 0, 1};
+  // A scene document that does not say "enabled" (parseScene):
+  // resolveDefaults turns shading on for 3-D data (every dimension above
+  // one node), off for a slice or a line. A ShadingSpec built in code says
+  // what it means.
+  bool automatic = false;
 };
 
 // One volume of a scene: its data, its transfer function, whether it shows.
@@ -150,6 +163,18 @@ CameraSpec automaticCamera(const GridGeometry& grid, int width, int height);
 // Fills what depends on the volume: unit distance (the smallest spacing),
 // step (half of it) and, for an automatic camera, automaticCamera. Throws
 // pvr::Error for an invalid grid. Afterwards nothing is automatic.
+// Shading without "enabled" is resolved too (on for 3-D data).
 void resolveDefaults(Scene& scene, const GridGeometry& grid);
+
+// A white ramp of opacity 0 at `min` to 1 at `max` (a one-value range gets
+// a span of 1 above it): the transfer function of a scene that names none.
+TransferFunctionSpec rampTransfer(double min, double max);
+
+// Fills what depends on the data's values, [min, max] over the finite
+// voxels of the whole volume: an automatic transfer function becomes
+// rampTransfer(min, max), and a preset to rescale has its scalars mapped
+// linearly from its first..last point onto [min, max]. Both are done once:
+// afterwards the function is neither automatic nor to rescale.
+void resolveDataDefaults(TransferFunctionSpec& transfer, double min, double max);
 
 }  // namespace pvr::core

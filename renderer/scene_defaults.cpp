@@ -54,6 +54,39 @@ void resolveDefaults(Scene& scene, const GridGeometry& grid) {
                     numberText(kMaxSamplesPerRay) + " are allowed, so the step must be at least " +
                     numberText(diagonal / kMaxSamplesPerRay));
   if (scene.camera.automatic) scene.camera = automaticCamera(grid, scene.image.width, scene.image.height);
+  if (scene.shading.automatic) {
+    // Gradients need three dimensions: a slice or a line stays unshaded.
+    scene.shading.enabled = grid.dims.x > 1 && grid.dims.y > 1 && grid.dims.z > 1;
+    scene.shading.automatic = false;
+  }
+}
+
+TransferFunctionSpec rampTransfer(double min, double max) {
+  if (!(max > min)) max = min + 1;
+  // Clear below the first tenth of the range: air and scanner noise fill
+  // most of a CT or MRI box, and a ramp from the very bottom turns them
+  // into a haze that hides the head (the CT head rendered grey to the
+  // box's edges so).
+  constexpr double kClearFraction = 0.1;
+  TransferFunctionSpec tf;
+  tf.points = {{min, 1, 1, 1, 0}, {min + kClearFraction * (max - min), 1, 1, 1, 0}, {max, 1, 1, 1, 1}};
+  return tf;
+}
+
+void resolveDataDefaults(TransferFunctionSpec& transfer, double min, double max) {
+  if (transfer.automatic) {
+    const double unit = transfer.unitDistance;
+    transfer = rampTransfer(min, max);
+    transfer.unitDistance = unit;
+  } else if (transfer.rescaleToData && !transfer.points.empty()) {
+    // x -> min + (x - x0) * (max - min) / (x1 - x0); a one-scalar preset
+    // has no span to stretch and moves to min.
+    const double x0 = transfer.points.front().scalar, x1 = transfer.points.back().scalar;
+    const double scale = x1 > x0 ? (max - min) / (x1 - x0) : 0;
+    for (TransferPoint& p : transfer.points) p.scalar = min + (p.scalar - x0) * scale;
+    transfer.points.back().scalar = x1 > x0 ? max : min;  // exact, whatever the rounding
+  }
+  transfer.rescaleToData = false;
 }
 
 }  // namespace pvr::core

@@ -59,7 +59,11 @@ ShadingSpec parseShading(const json& v) {
   const std::string path = "shading";
   requireObject(v, path, {"enabled", "ambient", "diffuse", "specular", "shininess", "light_direction"});
   ShadingSpec s;
-  if (const json* k = find(v, "enabled")) s.enabled = asBool(*k, path + ".enabled");
+  s.automatic = true;
+  if (const json* k = find(v, "enabled")) {
+    s.enabled = asBool(*k, path + ".enabled");
+    s.automatic = false;
+  }
   if (const json* k = find(v, "ambient")) s.ambient = nonNegative(*k, path + ".ambient");
   if (const json* k = find(v, "diffuse")) s.diffuse = nonNegative(*k, path + ".diffuse");
   if (const json* k = find(v, "specular")) s.specular = nonNegative(*k, path + ".specular");
@@ -72,12 +76,14 @@ ShadingSpec parseShading(const json& v) {
 }
 
 json shadingToJson(const ShadingSpec& shading) {
-  return {{"enabled", shading.enabled},
-          {"ambient", shading.ambient},
+  // "enabled" left to the data is the absent key.
+  json out = {{"ambient", shading.ambient},
           {"diffuse", shading.diffuse},
           {"specular", shading.specular},
           {"shininess", shading.shininess},
           {"light_direction", toJson(shading.lightDirection)}};
+  if (!shading.automatic) out["enabled"] = shading.enabled;
+  return out;
 }
 
 }  // namespace pvr::core

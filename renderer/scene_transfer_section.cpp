@@ -47,7 +47,7 @@ TransferFunctionSpec presetFile(const json& v, const std::string& path, const st
 }  // namespace
 
 TransferFunctionSpec parseTransfer(const json& v, const std::string& baseDir, const std::string& path) {
-  requireObject(v, path, {"points", "paraview_preset", "paraview", "unit_distance"});
+  requireObject(v, path, {"points", "paraview_preset", "paraview", "unit_distance", "absolute"});
   const std::string form = exactlyOneOf(v, path, {"points", "paraview_preset", "paraview"},
                                         "'points', 'paraview_preset' (a preset file) or 'paraview' (a preset inline)");
   const std::string p = childPath(path, form);
@@ -56,13 +56,20 @@ TransferFunctionSpec parseTransfer(const json& v, const std::string& baseDir, co
   else if (form == "paraview_preset") tf = presetFile(v[form], p, baseDir);
   else tf = paraViewPresetFromJson(v[form], p);
   if (const json* u = find(v, "unit_distance")) tf.unitDistance = positive(*u, childPath(path, "unit_distance"));
+  // A preset is stretched onto the data's range unless "absolute" keeps its
+  // scalars (ParaView's behaviour); control points are absolute unless
+  // "absolute": false asks for the same stretch.
+  bool absolute = form == "points";
+  if (const json* a = find(v, "absolute")) absolute = asBool(*a, childPath(path, "absolute"));
+  tf.rescaleToData = !absolute;
   return tf;
 }
 
 TransferFunctionSpec defaultTransfer() {
-  // A white ramp over the range of the procedural volumes, [0, 1].
-  TransferFunctionSpec tf;
-  tf.points = {{0, 1, 1, 1, 0}, {1, 1, 1, 1, 1}};
+  // A white ramp over the data's range once it is known (resolveDataDefaults);
+  // until then over [0, 1], the range of the procedural volumes.
+  TransferFunctionSpec tf = rampTransfer(0, 1);
+  tf.automatic = true;
   return tf;
 }
 
@@ -73,6 +80,8 @@ json transferToJson(const TransferFunctionSpec& transfer) {
   for (const TransferPoint& p : transfer.points)
     out["points"].push_back(json::array({p.scalar, p.r, p.g, p.b, p.opacity}));
   if (transfer.unitDistance > 0) out["unit_distance"] = transfer.unitDistance;
+  // A preset not yet stretched onto the data prints as its points, still to stretch.
+  if (transfer.rescaleToData) out["absolute"] = false;
   return out;
 }
 

@@ -55,7 +55,7 @@ json volumesToJson(const std::vector<SceneVolume>& volumes) {
   for (const SceneVolume& v : volumes) {
     json entry = volumeToJson(v.source);
     entry[kName] = v.name;
-    entry[kTransfer] = transferToJson(v.transfer);
+    if (!v.transfer.automatic) entry[kTransfer] = transferToJson(v.transfer);
     entry[kVisible] = v.visible;
     out.push_back(std::move(entry));
   }

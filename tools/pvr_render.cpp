@@ -124,22 +124,11 @@ bool isSceneFile(const std::string& path) {
   return doc.is_object() && (doc.contains("volume") || doc.contains("volumes"));
 }
 
-// The scene of a bare volume file: defaults fit to the data. The white
-// opacity ramp spans the finite values the reader found, starting at a
-// tenth of the range so that air and scanner noise (which fill most of a
-// CT or MRI box) stay clear instead of filling the frame with haze; a
-// constant volume keeps the scene's default ramp. Shading is on because
-// what people look for in real data are surfaces.
-constexpr double kRampStart = 0.1;
-pvr::core::Scene sceneOfVolume(const std::string& path, const pvr::core::Brick& volume) {
-  using nlohmann::json;
-  json doc = {{"volume", {{"file", std::filesystem::absolute(path).string()}}}, {"shading", {{"enabled", true}}}};
-  const pvr::core::ValueRange& range = volume.valueRange();
-  if (range.max > range.min)
-    doc["transfer_function"] = {{"points", json::array({json::array({range.min, 1, 1, 1, 0}),
-                                                         json::array({range.min + kRampStart * (range.max - range.min), 1, 1, 1, 0}),
-                                                         json::array({range.max, 1, 1, 1, 1})})}};
-  return pvr::core::parseScene(doc, ".");
+// The scene of a bare volume file: every default is the data's
+// (resolveDefaults, resolveDataDefaults): the automatic camera, shading for
+// 3-D data, the white ramp over the value range.
+pvr::core::Scene sceneOfVolume(const std::string& path) {
+  return pvr::core::parseScene({{"volume", {{"file", std::filesystem::absolute(path).string()}}}}, ".");
 }
 
 }  // namespace
@@ -159,13 +148,16 @@ int main(int argc, char** argv) {
     } else {
       source = openVolumeFile(args.scene);
       volume = source->readAll();
-      scene = sceneOfVolume(args.scene, volume);
+      scene = sceneOfVolume(args.scene);
     }
     if (args.step > 0) scene.sampling.step = args.step;
     if (args.width > 0) scene.image.width = args.width, scene.image.height = args.height;
     if (args.preintegrated >= 0) scene.sampling.preintegrated = args.preintegrated == 1;
     if (args.shading >= 0) scene.shading.enabled = args.shading == 1;
     resolveDefaults(scene, source->grid());
+    // The data's range fits the default ramp or stretches a preset (one
+    // rule for every program: resolveDataDefaults).
+    resolveDataDefaults(scene.volumes.front().transfer, volume.valueRange().min, volume.valueRange().max);
 
     RenderOptions options = renderOptionsFor(scene);
     if (args.skip >= 0) options.skipEmpty = args.skip == 1;

@@ -125,7 +125,8 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
   // forward), bring each to host order and preprocess it while it is in
   // cache: the voxels are touched once.
   const bool swap = size > 1 && layout.bigEndian != (std::endian::native == std::endian::big);
-  SlabPreprocessor pre(type, owned, stored);
+  const NodeBox counted = countedBox(owned, grid);
+  SlabPreprocessor pre(type, owned, stored, &counted);
   std::byte* voxels = brick.bytes();
   // The file bytes of the group of slabs starting at z0: from its first
   // run to the end of its last.
@@ -175,7 +176,7 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
   });
   const auto preStart = Clock::now();
   Preprocessed result = pre.finish();
-  brick.setPreprocessed(result.range, std::move(result.bounds));
+  brick.setPreprocessed(result.range, std::move(result.bounds), std::move(result.histogram));
   brick.loadTimes().preprocess += since(preStart);
   return brick;
 }

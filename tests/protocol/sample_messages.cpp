@@ -55,7 +55,10 @@ std::vector<Message> sampleMessages() {
       PerformanceRequest{PerformanceQuery::kCompositing, kAllClusters},
       PerformanceReply{PerformanceQuery::kMemory, R"({"clusters":[{"index":0,"bytes":16777216}]})"},
       CatalogRequest{},
-      CatalogReply{{{"brain.slc", 1}, {"marschner_lobb", 1}, {"visible_human_256", 40}}},
+      CatalogReply{{{"brain", 1, "brain.nii", "nifti", {256, 256, 20}, "int16", ""},
+                    {"marschner_lobb", 1, "marschner_lobb.json", "raw+json", {41, 41, 41}, "float32", ""},
+                    {"visible_human_256", 40, "visible_human_256.series.json", "series", {256, 256, 256}, "uint8", ""},
+                    {"scan64", 1, "scan64.nrrd", "nrrd", {0, 0, 0}, "", "cannot be loaded: float64 is not supported"}}},
       Heartbeat{},
   };
   return samples;

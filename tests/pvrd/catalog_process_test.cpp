@@ -38,7 +38,9 @@ TEST_CASE("the catalog lists a time series once with its steps and not its step 
   c.hello();
   c.send(proto::CatalogRequest{});
   CHECK(c.expect<proto::CatalogReply>().datasets ==
-        std::vector<proto::CatalogEntry>{{"ball/ball.json", 1}, {"pattern/pattern.json", 2}, {"series/run.series.json", 3}});
+        std::vector<proto::CatalogEntry>{{"ball", 1, "ball/ball.json", "raw+json", {32, 32, 32}, "uint8", ""},
+                                         {"pattern", 2, "pattern/pattern.json", "raw+json", {32, 32, 32}, "uint8", ""},
+                                         {"series/run", 3, "series/run.series.json", "series", {32, 32, 32}, "uint8", ""}});
 }
 
 TEST_CASE("a broken pvr-node path makes the catalog an error naming it, and pvrd serves on") {

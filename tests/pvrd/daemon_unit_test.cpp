@@ -90,16 +90,20 @@ bool processGone(const fs::path& pidFile) {
 
 }  // namespace
 
-TEST_CASE("the catalog is the node program's STEPS<TAB>NAME lines, its other lines are notes") {
+TEST_CASE("the catalog is the node program's dataset lines, its other lines are notes") {
   std::vector<std::string> notes;
   const auto listed = listDatasets(
       fakeNode("lists", "echo 'pvr-node --catalog: left out bad.json: not JSON' >&2\n"
-                        "printf '1\\tball/ball.json\\n50\\truns/run.series.json\\n'\n"
+                        "printf '1\\tball\\tball/ball.json\\traw+json\\t32\\t32\\t32\\tuint8\\t\\n"
+                        "50\\truns/run\\truns/run.series.json\\tseries\\t8\\t8\\t4\\tfloat32\\t\\n"
+                        "1\\twide\\twide.nhdr\\tnrrd\\t0\\t0\\t0\\t\\tcannot be loaded: double\\n'\n"
                         "test \"$1 $2\" = \"--catalog /the/dir\" || echo 'wrong arguments' >&2"),
       "/the/dir", 10, [&](const std::string& n) { notes.push_back(n); });
   REQUIRE(std::holds_alternative<std::vector<pvr::proto::CatalogEntry>>(listed));
   CHECK(std::get<0>(listed) ==
-        std::vector<pvr::proto::CatalogEntry>{{"ball/ball.json", 1}, {"runs/run.series.json", 50}});
+        std::vector<pvr::proto::CatalogEntry>{{"ball", 1, "ball/ball.json", "raw+json", {32, 32, 32}, "uint8", ""},
+                                              {"runs/run", 50, "runs/run.series.json", "series", {8, 8, 4}, "float32", ""},
+                                              {"wide", 1, "wide.nhdr", "nrrd", {0, 0, 0}, "", "cannot be loaded: double"}});
   CHECK(notes == std::vector<std::string>{"pvr-node --catalog: left out bad.json: not JSON"});
 }
 
@@ -115,21 +119,21 @@ TEST_CASE("a catalog program that fails, is missing or prints nonsense gives an 
   CHECK(missing.code == ErrorCode::kIo);
   CHECK_THAT(missing.text, Catch::Contains("/nonexistent/pvr-node --catalog /d") && Catch::Contains("status 127"));
 
-  const auto garbled = errorOf(listDatasets(fakeNode("garbled", "printf '12x\\tname\\n'"), "/d", 10, ignore));
-  CHECK_THAT(garbled.text, Catch::Contains("malformed line '12x\\x09name'"));
-  const auto zero = errorOf(listDatasets(fakeNode("zero", "printf '0\\tname\\n'"), "/d", 10, ignore));
+  const auto garbled = errorOf(listDatasets(fakeNode("garbled", "printf '12x\\tname\\tname.json\\traw+json\\t1\\t1\\t1\\tuint8\\t\\n'"), "/d", 10, ignore));
+  CHECK_THAT(garbled.text, Catch::Contains("malformed line '12x\\x09name"));
+  const auto zero = errorOf(listDatasets(fakeNode("zero", "printf '0\\tname\\tname.json\\traw+json\\t1\\t1\\t1\\tuint8\\t\\n'"), "/d", 10, ignore));
   CHECK_THAT(zero.text, Catch::Contains("malformed line"));
 }
 
 // Issue 15, finding 15: a catalog over 4 MiB was sent, and the client
 // (which must refuse it) lost its session. 40000 names of 131 bytes make a
-// reply of 5.6 MB; the protocol's limit for it is 4 MiB.
+// reply of 7.0 MB (with each entry's file, format, dims and type); the limit is 4 MiB.
 TEST_CASE("a catalog reply over the protocol's limit is refused with LIMIT_EXCEEDED naming its size and the limit") {
   const auto big = errorOf(listDatasets(
-      fakeNode("big", "awk 'BEGIN { for (i = 0; i < 40000; i++) printf \"1\\td%0125d.json\\n\", i }'"), "/d", 20,
+      fakeNode("big", "awk 'BEGIN { for (i = 0; i < 40000; i++) printf \"1\\td%0125d\\td.json\\tf\\t1\\t1\\t1\\tuint8\\t\\n\", i }'"), "/d", 20,
       [](const std::string&) {}));
   CHECK(big.code == ErrorCode::kLimitExceeded);
-  CHECK_THAT(big.text, Catch::Contains("the catalog of 40000 datasets is 5560004 bytes, over the protocol's limit of "
+  CHECK_THAT(big.text, Catch::Contains("the catalog of 40000 datasets is 6960004 bytes, over the protocol's limit of "
                                        "4194304 bytes for a catalog reply"));
   // One that fits still lists.
   const std::vector<pvr::proto::CatalogEntry> fits(1000, {std::string(100, 'd'), 1});

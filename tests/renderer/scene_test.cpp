@@ -189,7 +189,7 @@ TEST_CASE("unknown keys are errors naming the key path and the known keys", "[sc
       {"/fov", "fov: unknown key (known: volume, volumes, timestep, transfer_function, parameters, camera, image, sampling, shading)"},
       {"/camera/fov", "camera.fov: unknown key (known: projection, eye, look_at, up, height, fov_y_deg)"},
       {"/volume/dim", "volume.dim: unknown key (known: file, procedural, computation, dims, spacing)"},
-      {"/transfer_function/point", "transfer_function.point: unknown key (known: points, paraview_preset, paraview, unit_distance)"},
+      {"/transfer_function/point", "transfer_function.point: unknown key (known: points, paraview_preset, paraview, unit_distance, absolute)"},
       {"/image/size", "image.size: unknown key (known: width, height, background)"},
       {"/sampling/steps", "sampling.steps: unknown key (known: step, preintegrated, early_termination)"},
       {"/shading/light", "shading.light: unknown key (known: enabled, ambient, diffuse, specular, shininess, light_direction)"},
@@ -364,7 +364,9 @@ TEST_CASE("parseScene(sceneToJson(s)) gives back s", "[scene]") {
     const json printed = sceneToJson(s);
     CHECK_FALSE(printed.contains("camera"));
     CHECK_FALSE(printed["sampling"].contains("step"));
-    CHECK_FALSE(printed["transfer_function"].contains("unit_distance"));
+    // Left to the data: the transfer function and whether to shade.
+    CHECK_FALSE(printed.contains("transfer_function"));
+    CHECK_FALSE(printed["shading"].contains("enabled"));
     requireSameScene(parseScene(printed, ""), s);
   }
 }
@@ -493,4 +495,73 @@ TEST_CASE("parseCameraSection(cameraSectionToJson(c)) gives back c", "[scene]") 
     CHECK(back.fovYDeg == c.fovYDeg);
     CHECK_FALSE(back.automatic);
   }
+}
+
+TEST_CASE("a scene without a transfer function gets a white ramp over the data's range", "[scene]") {
+  Scene s = parseScene(json::parse(R"({"volume": {"file": "ct.nhdr"}})"), "");
+  TransferFunctionSpec& tf = s.volumes.front().transfer;
+  CHECK(tf.automatic);
+  // Printed, it stays left to the data.
+  CHECK_FALSE(sceneToJson(s).contains("transfer_function"));
+  // A CT in Hounsfield units: transparent air, opaque metal.
+  resolveDataDefaults(tf, -1024, 2986);
+  CHECK_FALSE(tf.automatic);
+  REQUIRE(tf.points.size() == 3);
+  CHECK(tf.points[0].scalar == -1024);
+  CHECK(tf.points[0].opacity == 0);
+  // Clear up to the first tenth of the range (air and noise), then rising.
+  CHECK(tf.points[1].scalar == Approx(-1024 + 401));
+  CHECK(tf.points[1].opacity == 0);
+  CHECK(tf.points[2].scalar == 2986);
+  CHECK(tf.points[2].opacity == 1);
+  CHECK((tf.points[2].r == 1 && tf.points[2].g == 1 && tf.points[2].b == 1));
+  // Once resolved it stays: another range changes nothing.
+  resolveDataDefaults(tf, 0, 1);
+  CHECK(tf.points[2].scalar == 2986);
+  // A constant volume still gets a ramp that rises.
+  CHECK(rampTransfer(5, 5).points[2].scalar == 6);
+}
+
+TEST_CASE("control points are absolute, a preset is stretched onto the data unless absolute", "[scene]") {
+  const json preset = json::parse(R"([{"RGBPoints": [0, 0, 0, 0, 0.5, 1, 0, 0, 1, 1, 1, 1]}])");
+  Scene stretched = parseScene({{"volume", {{"file", "ct.nhdr"}}}, {"transfer_function", {{"paraview", preset}}}}, "");
+  resolveDataDefaults(stretched.volumes.front().transfer, -1000, 3000);
+  const auto& p = stretched.volumes.front().transfer.points;
+  REQUIRE(p.size() == 3);
+  CHECK(p[0].scalar == -1000);
+  CHECK(p[1].scalar == Approx(1000));
+  CHECK(p[2].scalar == 3000);
+
+  Scene absolute = parseScene(
+      {{"volume", {{"file", "ct.nhdr"}}}, {"transfer_function", {{"paraview", preset}, {"absolute", true}}}}, "");
+  resolveDataDefaults(absolute.volumes.front().transfer, -1000, 3000);
+  CHECK(absolute.volumes.front().transfer.points.back().scalar == 1);
+
+  Scene points = parseScene(
+      json::parse(R"({"volume": {"file": "ct.nhdr"}, "transfer_function": {"points": [[0, 1, 1, 1, 0], [1, 1, 1, 1, 1]]}})"), "");
+  resolveDataDefaults(points.volumes.front().transfer, -1000, 3000);
+  CHECK(points.volumes.front().transfer.points.back().scalar == 1);
+
+  // Printed before the data is known, a preset still to stretch says so and reads back the same.
+  const Scene again = parseScene(sceneToJson(parseScene({{"volume", {{"file", "ct.nhdr"}}},
+                                                         {"transfer_function", {{"paraview", preset}}}}, "")), "");
+  CHECK(again.volumes.front().transfer.rescaleToData);
+}
+
+TEST_CASE("shading left to the data is on for 3-D volumes, off for a slice, as set when set", "[scene]") {
+  GridGeometry volume;
+  volume.dims = {8, 8, 8};
+  GridGeometry slice;
+  slice.dims = {8, 8, 1};
+  Scene s = parseScene(json::parse(R"({"volume": {"file": "ct.nhdr"}})"), "");
+  CHECK(s.shading.automatic);
+  CHECK_FALSE(sceneToJson(s)["shading"].contains("enabled"));
+  Scene a = s, b = s;
+  resolveDefaults(a, volume);
+  CHECK(a.shading.enabled);
+  resolveDefaults(b, slice);
+  CHECK_FALSE(b.shading.enabled);
+  Scene off = parseScene(json::parse(R"({"volume": {"file": "ct.nhdr"}, "shading": {"enabled": false}})"), "");
+  resolveDefaults(off, volume);
+  CHECK_FALSE(off.shading.enabled);
 }
