@@ -31,6 +31,9 @@ std::vector<std::string> closestNames(const std::string& name, const std::vector
     const bool affix = !name.empty() && n.size() > name.size() &&
                        (n.compare(0, name.size(), name) == 0 || n.compare(n.size() - name.size(), name.size(), name) == 0);
     if (affix) d = std::min<std::size_t>(d, 1);
+    // A mistyped start of a longer name ("ct_haed" for "ct_head_cranium"):
+    // the distance to its start, plus one for the rest.
+    if (n.size() > name.size()) d = std::min(d, editDistance(name, n.substr(0, name.size())) + 1);
     if (d <= std::max(name.size(), n.size()) / 2 + 1) scored.push_back({d, i});
   }
   std::stable_sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) { return x.first < y.first; });

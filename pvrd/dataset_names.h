@@ -18,7 +18,8 @@ std::size_t editDistance(const std::string& a, const std::string& b);
 // Up to `most` of `names` nearest to `name`, nearest first (ties in the
 // given order), only those within half the longer name's length plus one
 // edit: a suggestion should look like what was typed. A name that `name`
-// starts or ends ("head" for "ct/head") counts as one edit away.
+// starts or ends ("head" for "ct/head") counts as one edit away, and a
+// longer name as one edit more than `name`'s distance to its start.
 std::vector<std::string> closestNames(const std::string& name, const std::vector<std::string>& names,
                                       std::size_t most = 3);
 

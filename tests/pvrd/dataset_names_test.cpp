@@ -21,6 +21,7 @@ TEST_CASE("the closest names come nearest first, only when they look alike") {
   CHECK(closestNames("hed", names) == std::vector<std::string>{"head", "heart"});
   CHECK(closestNames("ct_head", names).front() == "ct_head_cranium");  // a prefix is one edit away
   CHECK(closestNames("orbital_oxiran_homo", names) == std::vector<std::string>{"orbital_oxirane_homo"});
+  CHECK(closestNames("ct_haed", names).front() == "ct_head_cranium");  // a mistyped start
   CHECK(closestNames("zzzzzzzzzz", names).empty());
   CHECK(closestNames("hea", names, 1).size() == 1);
 }
