@@ -27,14 +27,22 @@ std::vector<std::string> closestNames(const std::string& name, const std::vector
   std::vector<std::pair<std::size_t, std::size_t>> scored;  // (distance, index)
   for (std::size_t i = 0; i < names.size(); ++i) {
     const std::string& n = names[i];
+    // Alike: the whole names are within half the longer's length plus one
+    // edit; or `name` starts or ends the longer name (one edit away); or it
+    // is a start typed with at most a third of its letters wrong ("ct_haed"
+    // for "ct_head_cranium"), one edit more than that start's distance.
     std::size_t d = editDistance(name, n);
-    const bool affix = !name.empty() && n.size() > name.size() &&
-                       (n.compare(0, name.size(), name) == 0 || n.compare(n.size() - name.size(), name.size(), name) == 0);
-    if (affix) d = std::min<std::size_t>(d, 1);
-    // A mistyped start of a longer name ("ct_haed" for "ct_head_cranium"):
-    // the distance to its start, plus one for the rest.
-    if (n.size() > name.size()) d = std::min(d, editDistance(name, n.substr(0, name.size())) + 1);
-    if (d <= std::max(name.size(), n.size()) / 2 + 1) scored.push_back({d, i});
+    bool alike = d <= std::max(name.size(), n.size()) / 2 + 1;
+    if (!name.empty() && n.size() > name.size()) {
+      if (n.compare(0, name.size(), name) == 0 || n.compare(n.size() - name.size(), name.size(), name) == 0) {
+        d = 1;
+        alike = true;
+      } else if (const std::size_t start = editDistance(name, n.substr(0, name.size())); start <= name.size() / 3) {
+        d = std::min(d, start + 1);
+        alike = true;
+      }
+    }
+    if (alike) scored.push_back({d, i});
   }
   std::stable_sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   std::vector<std::string> out;

@@ -16,10 +16,9 @@ namespace pvr::daemon {
 std::size_t editDistance(const std::string& a, const std::string& b);
 
 // Up to `most` of `names` nearest to `name`, nearest first (ties in the
-// given order), only those within half the longer name's length plus one
-// edit: a suggestion should look like what was typed. A name that `name`
-// starts or ends ("head" for "ct/head") counts as one edit away, and a
-// longer name as one edit more than `name`'s distance to its start.
+// given order), only those that look like what was typed
+// (dataset_names.cpp: close as a whole, a start or end of the name, or a
+// mistyped start).
 std::vector<std::string> closestNames(const std::string& name, const std::vector<std::string>& names,
                                       std::size_t most = 3);
 
