@@ -16,7 +16,8 @@ TEST_CASE("a session starts an MPI job that renders a frame, and bad dataset nam
   Client c(d.port);
   c.hello();
   c.send(proto::CatalogRequest{});
-  CHECK(c.expect<proto::CatalogReply>().datasets == std::vector<proto::CatalogEntry>{{"ball/ball.json", 1}});
+  CHECK(c.expect<proto::CatalogReply>().datasets ==
+        std::vector<proto::CatalogEntry>{{"ball", 1, "ball/ball.json", "raw+json", {32, 32, 32}, "uint8", ""}});
   c.openSession();
   c.renderAndCheck();
   c.send(proto::SetScene{"../render/ball/ball.json", ""});
