@@ -1,13 +1,12 @@
 # gui.tcl -- the PVR GUI (paper 003, Figure 13).
 #
 #   pvrsh examples/gui.tcl ?-host HOST:PORT? ?-ranks N? ?-dataset NAME?
-#                          ?-imagesz WxH? ?-datadir DIR?
+#                          ?-imagesz WxH?
 #
 # With -host it connects at once (otherwise type the address and press
-# Connect; PVR_SERVER sets the default). -dataset picks a catalog entry (a
-# directory name picks the sidecar inside it). -datadir is pvrd's data
-# directory when this machine can read it: the transfer-function editor then
-# shows the dataset's histogram.
+# Connect; PVR_SERVER sets the default). -dataset picks a catalog entry by
+# its name (the file's stem) or file name. The transfer-function editor
+# shows the histogram the server counted when it loaded the data.
 #
 # Drag the image to turn the view about the camera the server reports; the
 # arrows turn it by 15 degrees. The transfer-function editor spans the

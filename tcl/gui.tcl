@@ -1,6 +1,6 @@
 # gui.tcl -- the PVR GUI after Figure 13 of paper 003, started by
 # `pvrsh examples/gui.tcl ?-host HOST:PORT? ?-ranks N? ?-dataset NAME?
-# ?-imagesz WxH? ?-datadir DIR?`.
+# ?-imagesz WxH?`.
 #
 # Windows:
 #   .       image view (drag to rotate), connection, dataset, image size,
@@ -16,13 +16,9 @@
 #
 # What the server says about the scene comes from `list status` (docs/
 # protocol.md, StatusReply): the camera the view orbits, the data's value
-# range for the transfer-function editor, the points of a loaded preset,
-# and the compositing strategies the layout window offers.
-#
-# -datadir names the daemon's data directory when it is readable here (pvrd
-# on this machine): the dataset's JSON sidecar then gives the histogram
-# behind the transfer-function editor. Without it the editor shows a plain
-# ramp.
+# range and 256-bin histogram for the transfer-function editor (counted by
+# the server when it loaded the data: no file is read here), the points of
+# a loaded preset, and the compositing strategies the layout window offers.
 
 package require Tk 8.6
 
@@ -38,7 +34,6 @@ namespace eval ::pvr::gui {
         ranks 1
         dataset ""
         imagesz 512x512
-        datadir ""
         tflo 0
         tfhi 1
         axis 0,0,1
@@ -80,14 +75,14 @@ proc ::pvr::gui::main {args} {
     variable session
     if {[llength $args] % 2 != 0} {
         return -code error -errorcode {PVR ARGS} \
-            "usage: gui.tcl ?-host HOST:PORT? ?-ranks N? ?-dataset NAME? ?-imagesz WxH? ?-datadir DIR?"
+            "usage: gui.tcl ?-host HOST:PORT? ?-ranks N? ?-dataset NAME? ?-imagesz WxH?"
     }
     set connect 0
     foreach {key value} $args {
         set name [string range $key 1 end]
-        if {$name ni {host ranks dataset imagesz datadir}} {
+        if {$name ni {host ranks dataset imagesz}} {
             return -code error -errorcode {PVR ARGS OPTION} \
-                "bad option \"$key\": must be -host, -ranks, -dataset, -imagesz or -datadir"
+                "bad option \"$key\": must be -host, -ranks, -dataset or -imagesz"
         }
         set opt($name) $value
         if {$name eq "host"} {
@@ -323,26 +318,29 @@ proc ::pvr::gui::disconnect {} {
     status "disconnected"
 }
 
-# ::pvr::gui::sidecar --
-#   The histogram of dataset `name` from its JSON sidecar under -datadir: a
-#   dict with edges and fractions, empty when unknown. The sidecar's layout
-#   is fixed (see the data README), so two patterns read it without a JSON
-#   package.
-proc ::pvr::gui::sidecar {name} {
-    variable opt
-    if {$opt(datadir) eq "" || [file extension $name] ne ".json"} {
+# ::pvr::gui::serverHistogram --
+#   The server's histogram of the data (status `histogram`, 256 counts over
+#   `value_range`) as the editor takes it: a dict with edges (257 scalars)
+#   and fractions of all voxels; empty when the status has none.
+proc ::pvr::gui::serverHistogram {remote} {
+    if {![dict exists $remote histogram] || ![dict exists $remote value_range]} {
         return {}
     }
-    set path [file join $opt(datadir) $name]
-    if {[catch {set f [open $path]; set text [read $f]; close $f}]} {
+    set counts [dict get $remote histogram]
+    lassign [dict get $remote value_range] lo hi
+    set total 0
+    foreach n $counts {
+        incr total $n
+    }
+    if {[llength $counts] == 0 || $total == 0 || !($lo < $hi)} {
         return {}
     }
-    set info {}
-    if {[regexp {"edges":\s*\[([^\]]*)\]} $text -> edges] && [regexp {"fractions":\s*\[([^\]]*)\]} $text -> fractions]} {
-        dict set info edges [string map {, " "} $edges]
-        dict set info fractions [string map {, " "} $fractions]
+    set n [llength $counts]
+    set edges {}
+    for {set i 0} {$i <= $n} {incr i} {
+        lappend edges [expr {$lo + ($hi - $lo) * $i / double($n)}]
     }
-    return $info
+    return [dict create edges $edges fractions [lmap c $counts {expr {double($c) / $total}}]]
 }
 
 # ::pvr::gui::loadDataset --
@@ -355,12 +353,8 @@ proc ::pvr::gui::loadDataset {name} {
     variable tfPending
     variable rangePending
     set opt(dataset) $name
-    set info [sidecar $name]
-    if {[dict exists $info edges]} {
-        ::pvr::gui::tfeditor::histogram .ctl.tf.editor [dict get $info edges] [dict get $info fractions]
-    } else {
-        ::pvr::gui::tfeditor::histogram .ctl.tf.editor {} {}
-    }
+    # Until the server has the new data's histogram (readScene).
+    ::pvr::gui::tfeditor::histogram .ctl.tf.editor {} {}
     lassign [split $opt(imagesz) x] w h
     if {[catch {$session set -dataset $name -imagesz $w,$h} message]} {
         status "dataset $name: $message" error
@@ -389,8 +383,8 @@ proc ::pvr::gui::serverStatus {} {
 # ::pvr::gui::readScene --
 #   The view's camera source, asked before a request when the dataset has
 #   changed: returns the server's camera {eye look_at up} ({} when it has
-#   none yet), and fits the editor to the data's value range for a new
-#   dataset.
+#   none yet), and fits the editor to the data's value range and
+#   histogram for a new dataset.
 proc ::pvr::gui::readScene {} {
     variable opt
     variable rangePending
@@ -402,6 +396,10 @@ proc ::pvr::gui::readScene {} {
             set opt(tflo) $lo
             set opt(tfhi) $hi
             ::pvr::gui::tfeditor::range .ctl.tf.editor $lo $hi
+        }
+        set hist [serverHistogram $remote]
+        if {[dict exists $hist edges]} {
+            ::pvr::gui::tfeditor::histogram .ctl.tf.editor [dict get $hist edges] [dict get $hist fractions]
         }
         set rangePending 0
     }

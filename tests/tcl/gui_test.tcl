@@ -174,7 +174,7 @@ proc steps {} {
 # ---- Step 2: the GUI and its first frame ----
 source [file join $arg(-source) tcl gui.tcl]
 set photo $::pvr::gui::image
-::pvr::gui::main -host 127.0.0.1:$port -ranks 1 -dataset block -imagesz 128x128 -datadir $data
+::pvr::gui::main -host 127.0.0.1:$port -ranks 1 -dataset block -imagesz 128x128
 update
 
 # idle: no request in flight and none waiting.
@@ -221,6 +221,21 @@ check "first frame: no time slider for a single volume" {![winfo ismapped .ctl.t
 check "first frame: the editor spans the server's value range" \
     {[::pvr::gui::tfeditor::range .ctl.tf.editor] == [lmap v [dict get $remote value_range] {expr {double($v)}}]} \
     "range [::pvr::gui::tfeditor::range .ctl.tf.editor], value_range [dict get $remote value_range]"
+# Issue 14, point 1: the editor draws the histogram the server counted (no
+# file read by the client): its fractions are the server's counts over all
+# voxels, and its bars are on the canvas.
+set serverCounts [dict get [$::pvr::gui::session info] histogram]
+set total 0
+foreach n $serverCounts {incr total $n}
+set editorHist $::pvr::gui::tfeditor::state(.ctl.tf.editor,hist)
+check "editor: the histogram is the server's, 256 bins over its range" \
+    {[llength [lindex $editorHist 1]] == 256 && $total == 32 * 32 * 32 && [lindex $serverCounts end] == 10 * 22 * 18 &&
+     [lindex $editorHist 0 0] == 0.0 && [lindex $editorHist 0 end] == 200.0 &&
+     abs([lindex $editorHist 1 0] - double([lindex $serverCounts 0]) / $total) < 1e-12 &&
+     abs([lindex $editorHist 1 end] - double([lindex $serverCounts end]) / $total) < 1e-12} \
+    "editor [lrange [lindex $editorHist 1] 0 3] server [lrange $serverCounts 0 3] total $total"
+check "editor: the histogram's bars are drawn" {[llength [.ctl.tf.editor find withtag histogram]] >= 2} \
+    "[llength [.ctl.tf.editor find withtag histogram]] bars"
 
 # ---- Step 3: a drag on the image ----
 set sentBefore $::pvr::gui::view::sent
