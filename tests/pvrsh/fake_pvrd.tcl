@@ -34,7 +34,7 @@ namespace eval ::fakepvrd {
     variable buffers
     array set buffers {}
     variable types {Hello 0x01 Welcome 0x02 Ok 0x05 Error 0x06 Close 0x07 SessionOpen 0x10 SessionReady 0x11
-        ImageFrame 0x22 StatusReply 0x31 CatalogReply 0x35}
+        ImageFrame 0x22 StatusReply 0x31 PerformanceReply 0x33 CatalogReply 0x35}
     variable renders {}
     variable catalogBytes 0
 }
@@ -168,6 +168,14 @@ proc ::fakepvrd::request {ch type id payload} {
             binary scan $payload iu target
             lappend received [list Cancel $id $target]
             send $ch Ok $id 1 ""
+        }
+        50 {
+            # PerformanceRequest: a reply whose JSON nests 100000 arrays
+            # deep (700 KB), as a hostile server might send.
+            lappend received [list PerformanceRequest $id {}]
+            binary scan $payload cu query
+            set json [string repeat \[ 100000][string repeat \] 100000]
+            send $ch PerformanceReply $id 1 [binary format c $query][str $json]
         }
         52 {
             lappend received [list CatalogRequest $id {}]

@@ -148,12 +148,15 @@ TEST_CASE("a scene with only a volume takes the defaults of scene.h", "[scene]")
   CHECK(s.shading.ambient == d.shading.ambient);
   CHECK(s.shading.lightDirection == d.shading.lightDirection);
   CHECK(s.volumes.front().transfer.unitDistance == 0);
-  // No transfer function: the documented white ramp over [0, 1].
-  REQUIRE(s.volumes.front().transfer.points.size() == 2);
+  // No transfer function: until the data's range is known, the documented
+  // white ramp over [0, 1], clear below its first tenth.
+  REQUIRE(s.volumes.front().transfer.points.size() == 3);
   CHECK(s.volumes.front().transfer.points[0].scalar == 0);
   CHECK(s.volumes.front().transfer.points[0].opacity == 0);
-  CHECK(s.volumes.front().transfer.points[1].scalar == 1);
-  CHECK(s.volumes.front().transfer.points[1].opacity == 1);
+  CHECK(s.volumes.front().transfer.points[1].scalar == Approx(0.1));
+  CHECK(s.volumes.front().transfer.points[1].opacity == 0);
+  CHECK(s.volumes.front().transfer.points[2].scalar == 1);
+  CHECK(s.volumes.front().transfer.points[2].opacity == 1);
 }
 
 TEST_CASE("a camera section turns the automatic camera off, perspective fov defaults to 30", "[scene]") {
