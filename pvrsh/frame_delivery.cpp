@@ -38,6 +38,12 @@ void Session::handleFrame(std::uint32_t id, const proto::ImageFrame& f, bool com
 }
 
 void Session::abandonSequence(std::uint32_t id, bool complete, const TclError& error) {
+  if (book_.sequences.count(id) == 0) return;
+  stopSequence(id, complete);
+  report(error);
+}
+
+void Session::stopSequence(std::uint32_t id, bool complete) {
   const auto it = book_.sequences.find(id);
   if (it == book_.sequences.end()) return;
   // The sequence ends first, whatever sending the Cancel then meets; the
@@ -54,7 +60,6 @@ void Session::abandonSequence(std::uint32_t id, bool complete, const TclError& e
       // The connection is going: its own failure is reported.
     }
   }
-  report(error);
 }
 
 void Session::runImageCallback(const FrameRecord& r) {

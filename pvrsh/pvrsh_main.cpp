@@ -58,12 +58,41 @@ int loadPvr(Tcl_Interp* interp) {
   )TCL";
   if (Tcl_Eval(interp, script.c_str()) != TCL_OK) return TCL_ERROR;
   if (gRunsScript) Tcl_SetVar2(interp, "::pvr::progress", nullptr, "1", TCL_GLOBAL_ONLY);
+  if (!gRunsScript) {
+    // Interactive: an asynchronous error (a refused set, a failed render)
+    // is one line on stderr as soon as it arrives, not a Tk dialog nor
+    // silence until the next command (issue 14, point 6). ~/.pvrshrc,
+    // read after this, may install another handler.
+    constexpr const char* kReport = R"TCL(
+      proc ::pvr::reportBackgroundError {message options} {
+          puts stderr "pvrsh: $message"
+          flush stderr
+      }
+      interp bgerror {} ::pvr::reportBackgroundError
+    )TCL";
+    if (Tcl_Eval(interp, kReport) != TCL_OK) return TCL_ERROR;
+  }
   Tcl_SetVar(interp, "tcl_rcFileName", "~/.pvrshrc", TCL_GLOBAL_ONLY);
   return TCL_OK;
 }
 
+// The Tcl shell's loop while it reads commands: Tcl_Main reads standard
+// input through a channel handler while this runs the event loop, so the
+// sessions' replies and errors are handled between commands too (a plain
+// Tcl_Main blocks in gets and handles them only at the next command). It
+// ends when standard input is at its end, as Tcl_Main's own reading does.
+void interactiveLoop() {
+  while (Tcl_Channel in = Tcl_GetStdChannel(TCL_STDIN)) {
+    if (Tcl_Eof(in)) break;
+    Tcl_DoOneEvent(TCL_ALL_EVENTS);
+  }
+}
+
 int tclAppInit(Tcl_Interp* interp) {
   if (Tcl_Init(interp) != TCL_OK) return TCL_ERROR;
+  // Tk has its own loop; with a script Tcl_Main would enter this one after
+  // it instead of exiting.
+  if (!gRunsScript) Tcl_SetMainLoop(interactiveLoop);
   return loadPvr(interp);
 }
 

@@ -69,6 +69,7 @@ void setDataset(Apply& a) {
   if (a.value.empty()) argsError("DATASET", "-dataset needs a dataset name (see list datasets)");
   a.settings.dataset = a.value;
   a.change.dataset = true;
+  a.change.datasetName = a.value;
 }
 
 // -cluster ROLE[,RANKS]: ROLE r (render), c (composite), k (collector) or
@@ -295,6 +296,7 @@ SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tc
       kOptions[index].apply(a);
     }
     remember(next, option, absolute ? value + " -absolute" : value);
+    change.shown.emplace_back(option, absolute ? value + " -absolute" : value);
     if (absolute) ++i;
   }
   if (cluster || group) {
@@ -371,6 +373,23 @@ std::string optionsHelp() {
     text += left + "default: " + (o->byDefault ? o->byDefault : "?") + "\n";
   }
   return text;
+}
+
+void applyChange(Settings& settings, const SettingsChange& change) {
+  if (change.dataset) settings.dataset = change.datasetName;
+  json patch = change.patch;
+  if (patch.is_object()) patch.erase("camera_moves");
+  settings.scene.merge_patch(patch);
+  for (const auto& [option, value] : change.shown) remember(settings, option, value);
+}
+
+SettingsChange wholeChange(const Settings& settings) {
+  SettingsChange change;
+  change.dataset = !settings.dataset.empty();
+  change.datasetName = settings.dataset;
+  change.patch = openingScene(settings);
+  change.shown = settings.shown;
+  return change;
 }
 
 json openingScene(const Settings& settings) {

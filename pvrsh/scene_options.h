@@ -31,9 +31,19 @@ struct Settings {
 // What one `set` call changed, to be sent to an open session.
 struct SettingsChange {
   bool dataset = false;                              // -dataset given
+  std::string datasetName;                           // its value
   nlohmann::json patch = nlohmann::json::object();   // merge patch of the scene keys given
   bool layout = false;                               // -cluster or -group given
+  std::vector<std::pair<std::string, std::string>> shown;  // option -> value as given, in order
 };
+
+// Applies what `change` sent to `settings`: the dataset, the scene keys
+// (camera moves apart: they are not kept) and the values shown. The
+// session keeps what the server accepted this way, one acknowledged
+// SetScene at a time (issue 14, point 6).
+void applyChange(Settings& settings, const SettingsChange& change);
+// Everything `settings` holds as one change: what `open` sends.
+SettingsChange wholeChange(const Settings& settings);
 
 // The names the server accepts, by status key (`strategies`,
 // `decompositions`; docs/protocol.md, StatusReply); nullopt when no server

@@ -88,15 +88,13 @@ void Session::close(const std::string& reason) {
   if (conn_ && conn_->connected()) conn_->send(proto::Close{reason}, 0);
   conn_.reset();
   book_.clear();
+  forgetSent();
   state_ = State::kClosed;
 }
 
 void Session::applySettings(const SettingsChange& change) {
   if (state_ != State::kOpen) return;  // sent by open
-  if (change.dataset || !change.patch.empty())
-    send(proto::SetScene{change.dataset ? settings_.dataset : std::string(),
-                         change.patch.empty() ? std::string() : change.patch.dump()},
-         false);
+  if (change.dataset || !change.patch.empty()) sendScene(change);
   settings_.cameraMoves = nlohmann::json::array();  // sent: moves apply once
   // Figure 5 sets render and compositing clusters in two commands; the
   // layout goes out whole with the next render, so no half layout is sent.
@@ -105,8 +103,13 @@ void Session::applySettings(const SettingsChange& change) {
 
 std::uint32_t Session::render(const proto::Message& request, std::uint32_t total, const std::string& label) {
   requireOpen("render");
+  // The rule of docs/pvrsh.md, "Refused settings": no frame of settings
+  // the user did not ask for.
+  if (refusal_)
+    throw TclError(refusal_->code(), "render: session " + name_ + ": " + refusal_->what() +
+                                         "; set a value the server accepts (or set the option again) first");
   if (layoutPending_) {
-    send(proto::SetLayout{settings_.clusters}, false);
+    layoutsSent_[send(proto::SetLayout{settings_.clusters}, false)] = settings_.clusters;
     layoutPending_ = false;
   }
   const std::uint32_t id = send(request, false);

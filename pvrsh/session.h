@@ -18,6 +18,7 @@
 //   frame_delivery.cpp    a frame into the photo, files and the callback
 //   sequence_report.cpp   timings: progress lines, tables, Tcl dicts
 //   session_status.cpp    `list status` and the server's status entries
+//   session_settled.cpp   what the server accepted of `set`, and its refusals
 //   session_commands.cpp  the subcommands (paper 003, Table 1)
 #pragma once
 
@@ -80,6 +81,11 @@ class Session : public Connection::Listener {
   std::vector<proto::Message> query(const proto::Message& request, double timeoutSeconds,
                                     const std::function<void(const proto::Message&)>& onProgress = {});
   Tcl_Obj* statusObj();
+  // Runs the event loop until the server has answered every `set` sent
+  // (at most `timeoutSeconds`), so that what `set` shows is what it
+  // accepted; returns at once with a sequence in flight (the master
+  // answers between waves) or when the session is not open.
+  void settle(double timeoutSeconds);
   // The camera in force as a dict (automatic, projection, eye, look_at, up,
   // fov_y_deg or height); errors when the server cannot say now.
   Tcl_Obj* cameraObj();
@@ -125,6 +131,18 @@ class Session : public Connection::Listener {
   // Ends sequence `id` early with `error`: its later frames are dropped and
   // the server is asked to stop it (unless it had its last frame).
   void abandonSequence(std::uint32_t id, bool complete, const TclError& error);
+  // abandonSequence without the report (the caller reports once for many).
+  void stopSequence(std::uint32_t id, bool complete);
+  // Forgets the sets and layouts in flight and the refusal (a connection
+  // ended or began); what was asked stays in settings_, for the next open.
+  void forgetSent();
+  // Sends `change` as a SetScene and remembers it until the server answers.
+  void sendScene(const SettingsChange& change);
+  // The server answered request `id` (a SetScene or SetLayout pvrsh
+  // remembers): accepted (no error) or refused (session_settled.cpp).
+  // Returns the error to report, which for a refused SetScene says what
+  // it did to the session; nullopt when `id` is not one of them.
+  std::optional<TclError> settled(std::uint32_t id, const std::optional<TclError>& error);
   // Ends the session from inside an arrival: the connection closes, every
   // request fails with `error`.
   void endSession(const TclError& error);
@@ -156,6 +174,15 @@ class Session : public Connection::Listener {
   std::optional<TclError> lastFailure_;           // why the connection ended
   std::string closeReason_;                       // the server's Close reason
   bool layoutPending_ = false;                    // a layout set since open, sent with the next render
+  // What the server accepted (issue 14, point 6): `settings_` is what was
+  // asked, `accepted_` what the server acknowledged; a refusal puts
+  // `settings_` back to `accepted_` plus the sets still unanswered.
+  Settings accepted_;
+  std::map<std::uint32_t, SettingsChange> scenesSent_;                   // SetScenes unanswered, by id
+  std::map<std::uint32_t, std::vector<proto::ClusterSpec>> layoutsSent_;  // SetLayouts unanswered
+  // The last SetScene the server refused, until the next `set` sends one:
+  // a render fails with it rather than use the settings the server kept.
+  std::optional<TclError> refusal_;
   bool deleted_ = false;
 };
 

@@ -80,7 +80,7 @@ void Session::act(Arrival& a) {
       }
       return;
     case Arrival::Kind::kRequestDone:
-      if (a.error) report(*a.error);
+      if (const auto error = settled(a.id, a.error)) report(*error);
       return;
     case Arrival::Kind::kTooManyReplies:
       endSession(*a.error);
@@ -106,6 +106,7 @@ void Session::onFailure(const TclError& error) {
   state_ = State::kFailed;
   lastFailure_ = e;
   book_.failPending(e);
+  forgetSent();
   const bool hadSequences = !book_.sequences.empty();
   std::vector<std::uint32_t> ids;
   for (const auto& [id, seq] : book_.sequences) ids.push_back(id);

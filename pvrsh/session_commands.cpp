@@ -206,11 +206,15 @@ int listCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
 // :s set OPTION VALUE ?OPTION VALUE ...?  |  :s set OPTION (its value)  |
 // :s set (every option: {option value default}, one per line)
 int setCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  // What is shown is what the server accepted: its answers to the sets
+  // sent are waited for first (a refused value is then gone).
   if (objc == 2) {
+    s.settle(30);
     Tcl_SetObjResult(interp, optionListing(s.settings_));
     return TCL_OK;
   }
   if (objc == 3) {
+    s.settle(30);
     Tcl_SetObjResult(interp, Tcl_NewStringObj(shownOption(interp, s.settings_, objv[2]).c_str(), -1));
     return TCL_OK;
   }

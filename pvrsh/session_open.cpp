@@ -101,9 +101,15 @@ void Session::open(const OpenRequest& request) {
     state_ = State::kOpen;
     layoutPending_ = false;
     // Step 4: what was set before the session opened.
-    const nlohmann::json scene = openingScene(settings_);
-    if (!settings_.dataset.empty() || !scene.empty())
-      send(proto::SetScene{settings_.dataset, scene.empty() ? std::string() : scene.dump()}, false);
+    // The server holds nothing yet: what it accepts of them is kept.
+    forgetSent();
+    accepted_ = Settings{};
+    accepted_.clusters = settings_.clusters;
+    const SettingsChange opening = wholeChange(settings_);
+    if (opening.dataset || !opening.patch.empty())
+      sendScene(opening);
+    else
+      accepted_ = settings_;
     settings_.cameraMoves = nlohmann::json::array();
   } catch (...) {
     if (!deleted_) {

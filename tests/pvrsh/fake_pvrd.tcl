@@ -27,6 +27,9 @@
 #                have zlib pixels that do not decompress
 #   close REASON Close (request id 0) instead of frames; the socket stays open
 #   half         the header and part of the first frame's payload, then nothing
+#
+# ::fakepvrd::sceneAnswers: one entry per SetScene, in order (those past
+# the list are accepted): `ok`, or `error CODE TEXT` to refuse it.
 namespace eval ::fakepvrd {
     variable listen ""
     variable script {}
@@ -37,6 +40,7 @@ namespace eval ::fakepvrd {
         ImageFrame 0x22 StatusReply 0x31 PerformanceReply 0x33 CatalogReply 0x35}
     variable renders {}
     variable catalogBytes 0
+    variable sceneAnswers {}
 }
 
 # ::fakepvrd::start SCRIPT: listens on an ephemeral loopback port; returns it.
@@ -46,6 +50,7 @@ proc ::fakepvrd::start {script {renders {}} {catalogBytes 0}} {
     set ::fakepvrd::script $script
     set ::fakepvrd::renders $renders
     set ::fakepvrd::catalogBytes $catalogBytes
+    set ::fakepvrd::sceneAnswers {}
     set listen [socket -server ::fakepvrd::accept -myaddr 127.0.0.1 0]
     return [lindex [fconfigure $listen -sockname] 2]
 }
@@ -146,9 +151,20 @@ proc ::fakepvrd::request {ch type id payload} {
             send $ch StatusReply $id 1 [binary format i 2][str state][str {session open}][str hosts][str {h1 h1 h2}]
         }
         18 - 19 {
-            # SetScene, SetLayout: accepted.
+            # SetScene, SetLayout: accepted, or a SetScene answered as
+            # ::fakepvrd::sceneAnswers says.
             lappend received [list $type $id {}]
-            send $ch Ok $id 1 ""
+            variable sceneAnswers
+            set answer ok
+            if {$type == 18 && [llength $sceneAnswers] > 0} {
+                set answer [lindex $sceneAnswers 0]
+                set sceneAnswers [lrange $sceneAnswers 1 end]
+            }
+            if {[lindex $answer 0] eq "error"} {
+                send $ch Error $id 1 [binary format s [lindex $answer 1]][str [lindex $answer 2]]
+            } else {
+                send $ch Ok $id 1 ""
+            }
         }
         32 - 33 - 36 {
             # RenderFrame (1 frame), RenderRotation (E - S + 1), RenderTimeSteps.
