@@ -3,8 +3,10 @@
 # ?-imagesz WxH?`.
 #
 # Windows:
-#   .       image view (drag to rotate), connection, dataset, image size,
-#           view buttons, rotation sequences, transfer-function editor,
+#   .       image view (drag to rotate; scaled to the window, gui_fit.tcl),
+#           connection, dataset, image size, view buttons, rotation
+#           sequences, rendering controls, presets and saving
+#           (gui_render.tcl), transfer-function editor,
 #           a time slider for a series dataset, progress bar and status line
 #   .stat   per-frame times, one bar part per phase of ::pvr::phases (stat.tcl)
 #   .layout cluster and group configuration (gui_layout.tcl)
@@ -62,7 +64,7 @@ namespace eval ::pvr::gui {
     variable timestep 0
 }
 
-foreach file {stat.tcl tfeditor.tcl gui_view.tcl gui_layout.tcl} {
+foreach file {stat.tcl tfeditor.tcl gui_view.tcl gui_layout.tcl gui_fit.tcl gui_render.tcl} {
     source [file join $::pvr::gui::dir $file]
 }
 unset file
@@ -122,7 +124,6 @@ proc ::pvr::gui::buildMain {} {
     # Left: the image view. Right: the controls.
     ttk::frame .view -padding 4
     label .view.image -image $image -background black -borderwidth 0 -cursor fleur
-    pack .view.image
     ttk::frame .ctl -padding 4
 
     # Connection.
@@ -160,7 +161,7 @@ proc ::pvr::gui::buildMain {} {
     ttk::button $f.up -text "\u25b2" -width 3 -command {::pvr::gui::view::turn 0 15}
     ttk::button $f.down -text "\u25bc" -width 3 -command {::pvr::gui::view::turn 0 -15}
     ttk::button $f.reset -text "Reset" -command ::pvr::gui::view::reset
-    ttk::button $f.render -text "Render" -command ::pvr::gui::view::request
+    ttk::button $f.render -text "Render" -command ::pvr::gui::requestFrame
     ttk::label $f.angles -width 30 -textvariable ::pvr::gui::anglesText
     grid x $f.up x $f.reset -padx 1 -pady 1
     grid $f.left $f.render $f.right $f.angles -padx 1 -pady 1
@@ -205,7 +206,9 @@ proc ::pvr::gui::buildMain {} {
     ttk::button $f.stat -text "Performance graph\u2026" -command {wm deiconify .stat; raise .stat}
     pack $f.layout $f.stat -side left -padx 2
 
-    pack .ctl.conn .ctl.data .ctl.view .ctl.seq .ctl.tf .ctl.more -fill x -pady 3
+    ::pvr::gui::render::build .ctl.render
+
+    pack .ctl.conn .ctl.data .ctl.view .ctl.seq .ctl.render .ctl.tf .ctl.more -fill x -pady 3
 
     # Bottom: progress bar and status line.
     ttk::frame .bar -padding {4 2}
@@ -214,9 +217,12 @@ proc ::pvr::gui::buildMain {} {
     pack .bar.progress -side left
     pack .bar.status -side left -fill x -expand 1 -padx 6
 
-    grid .view .ctl -sticky nw
+    # The view takes what the window has beside the controls.
+    grid .view .ctl -sticky nsew
     grid .bar - -sticky we
-    grid columnconfigure . 1 -weight 1
+    grid columnconfigure . 0 -weight 1
+    grid rowconfigure . 0 -weight 1
+    ::pvr::gui::fit::attach
 }
 
 proc ::pvr::gui::buildStat {} {
@@ -308,6 +314,24 @@ proc ::pvr::gui::connect {} {
         loadDataset $name
     }
     return 1
+}
+
+# ::pvr::gui::checkConnection --
+#   After an asynchronous error: when the session is no longer open (the
+#   job died, the server closed it), the button offers Connect again.
+proc ::pvr::gui::checkConnection {} {
+    variable session
+    variable connected
+    if {!$connected} {
+        return
+    }
+    set state failed
+    catch {set state [dict get [$session list status] state]}
+    if {$state ne "open"} {
+        markConnected 0
+        ::pvr::gui::view::finished
+        status "the session ended (state $state): press Connect to start a new one" error
+    }
 }
 
 proc ::pvr::gui::disconnect {} {
@@ -557,6 +581,10 @@ proc ::pvr::gui::send {args} {
     variable session
     variable request
     variable tfPending
+    variable connected
+    if {!$connected} {
+        return -code error -errorcode {PVR GUI NOTCONNECTED} "not connected: press Connect"
+    }
     if {$tfPending} {
         set tfPending 0
         $session set -tf [::pvr::gui::tfeditor::points .ctl.tf.editor]
@@ -567,29 +595,46 @@ proc ::pvr::gui::send {args} {
     status "rendering\u2026" busy
 }
 
+# ::pvr::gui::requestFrame --
+#   A frame of the current view (::pvr::gui::view::request); a failure is
+#   a message on the status line. Results: 1 when sent or queued.
+proc ::pvr::gui::requestFrame {} {
+    if {[catch {::pvr::gui::view::request} message]} {
+        status "render: $message" error
+        return 0
+    }
+    return 1
+}
+
 proc ::pvr::gui::renderSequence {} {
     variable session
     variable opt
     variable request
+    variable connected
+    if {!$connected} {
+        status "render rotate: not connected: press Connect" error
+        return 0
+    }
     if {$::pvr::gui::view::busy} {
         status "a request is in flight; cancel it first" error
-        return
+        return 0
     }
     set start [clock microseconds]
     # The sequence turns the view on screen, not the one reported before a drag.
     if {[catch {::pvr::gui::view::commit} message]} {
         status "render rotate: $message" error
-        return
+        return 0
     }
     if {[catch {$session render rotate $opt(axis) $opt(range)} total]} {
         status "render rotate: $total" error
-        return
+        return 0
     }
     set ::pvr::gui::view::busy 1
     set request [dict create kind sequence done 0 total $total start $start]
     set ::pvr::gui::progress 0
     .bar.progress configure -maximum $total
     status "rotate $opt(axis) $opt(range): 0/$total frames" busy
+    return 1
 }
 
 proc ::pvr::gui::cancel {} {
@@ -605,6 +650,14 @@ proc ::pvr::gui::cancel {} {
 proc ::pvr::gui::onFrame {frame timing} {
     variable request
     variable lastLatency
+    variable shownSize
+    # The view: a new size asks the window for room, then the frame is fitted.
+    set size [list [::image width $::pvr::gui::image] [::image height $::pvr::gui::image]]
+    if {![info exists shownSize] || $shownSize ne $size} {
+        set shownSize $size
+        ::pvr::gui::fit::request
+    }
+    ::pvr::gui::fit::refit
     set now [clock microseconds]
     dict incr request done
     set done [dict get $request done]
@@ -642,6 +695,8 @@ proc ::pvr::gui::onNotify {event args} {
                 status [format "sequence %s: %d frames in %.1f s" $event $done $secs]
             }
             dict set request kind none
+            ::pvr::gui::render::requestEnded $event
+            ::pvr::gui::layout::requestEnded
             ::pvr::gui::view::finished
         }
         error {
@@ -650,6 +705,8 @@ proc ::pvr::gui::onNotify {event args} {
                 markConnected 0
             }
             status "server: $message" error
+            # A dead job: the session is over (checked outside this callback).
+            after idle ::pvr::gui::checkConnection
         }
     }
 }

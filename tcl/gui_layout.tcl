@@ -27,6 +27,10 @@ namespace eval ::pvr::gui::layout {
     # the form's are sent only when they differ.
     variable inForce
     array set inForce {strategy "" decomposition ""}
+    # Apply: the layout goes out with the next request (pvrsh sends it
+    # before the render), so the window shows it when that request ends.
+    variable refreshPending 0
+    variable session ""
 }
 
 # ::pvr::gui::layout::show --
@@ -171,8 +175,64 @@ proc ::pvr::gui::layout::apply {session} {
         return
     }
     ::pvr::gui::status "layout applied: [join $settings { }]"
-    refresh $session
-    ::pvr::gui::view::request
+    variable refreshPending 1
+    set ::pvr::gui::layout::session $session
+    report "applying: [join $settings { }] (the layout in force shows when the next frame has rendered)"
+    ::pvr::gui::requestFrame
+}
+
+# ::pvr::gui::layout::requestEnded --
+#   A request ended: after Apply, the window shows the layout now in force.
+proc ::pvr::gui::layout::requestEnded {} {
+    variable refreshPending
+    variable session
+    if {!$refreshPending} {
+        return
+    }
+    set refreshPending 0
+    # Outside the notify callback: refresh asks the server.
+    after idle [list ::pvr::gui::layout::refresh $session]
+}
+
+# ::pvr::gui::layout::human --
+#   One value of a performance answer in human units by its key: bytes as
+#   KB, MB or GB, seconds as ms (or s), other numbers with 4 digits.
+proc ::pvr::gui::layout::human {key value} {
+    if {![string is double -strict $value]} {
+        return $value
+    }
+    if {[string match *bytes* $key]} {
+        foreach {unit size} {GB 1073741824.0 MB 1048576.0 KB 1024.0} {
+            if {abs($value) >= $size} {
+                return [format "%.1f %s" [expr {$value / $size}] $unit]
+            }
+        }
+        return [format "%d B" [expr {wide($value)}]]
+    }
+    if {[string match *seconds* $key] || [string match *_s $key]} {
+        if {abs($value) >= 1} {
+            return [format "%.2f s" $value]
+        }
+        return [format "%.2f ms" [expr {$value * 1e3}]]
+    }
+    if {[string is wide -strict $value]} {
+        return $value
+    }
+    return [format %.4g $value]
+}
+
+# ::pvr::gui::layout::humanLine --
+#   A performance dict as one line of `key value` pairs in human units.
+proc ::pvr::gui::layout::humanLine {item} {
+    set fields {}
+    dict for {k v} $item {
+        if {[catch {dict size $v}] || [llength $v] < 2 || [string is double -strict $v]} {
+            lappend fields "$k [human $k $v]"
+        } else {
+            lappend fields "$k {[humanLine $v]}"
+        }
+    }
+    return [join $fields {  }]
 }
 
 # ::pvr::gui::layout::query --
@@ -192,11 +252,7 @@ proc ::pvr::gui::layout::query {session what} {
             lappend lines "  $item"
             continue
         }
-        set fields {}
-        dict for {k v} $item {
-            lappend fields "$k=$v"
-        }
-        lappend lines "  [join $fields {  }]"
+        lappend lines "  [humanLine $item]"
     }
     report [join $lines \n]
     ::pvr::gui::status "performance $words: [llength $answer] clusters"
