@@ -27,7 +27,7 @@
 #      moving it sets the session's step and renders a new frame.
 # Writes DIR/gui_frame.png (the photo) and DIR/gui_screenshot.png (the whole
 # screen, when ImageMagick's import is installed). Exits 0 when all pass, 1
-# otherwise; gives up after 100 s.
+# otherwise; gives up after 140 s.
 
 package require Tk
 
@@ -70,8 +70,8 @@ proc finish {} {
     exit [expr {$::failures == 0 ? 0 : 1}]
 }
 
-after 100000 {
-    puts "FAIL timeout: the GUI test did not finish in 100 s"
+after 140000 {
+    puts "FAIL timeout: the GUI test did not finish in 140 s"
     incr ::failures
     finish
 }
@@ -519,6 +519,138 @@ check "time: moving the slider sets step 2 and renders another frame" \
     {$remoteStep == 2 && [pixels] ne $frameStep0 && $::pvr::gui::errors == 0} \
     "server step $remoteStep; status: $::pvr::gui::statusText"
 
+# ---- Step 10b: issue 14, point 9 ----
+# A 1024x1024 frame in an 800x600 window: the view shows it scaled inside
+# the window; the screenshot's pixels there are the shown image's.
+wm geometry . 800x600
+set sentBefore $::pvr::gui::view::sent
+set ::pvr::gui::opt(imagesz) 1024x1024
+::pvr::gui::applyImageSize
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 30
+update
+set shownImage [.view.image cget -image]
+set lx [winfo rootx .view.image]
+set ly [winfo rooty .view.image]
+set sw [image width $shownImage]
+set sh [image height $shownImage]
+check "fit: a 1024x1024 frame arrives whole in the photo" {[image width $photo] == 1024 && [image height $photo] == 1024}
+check "fit: the shown image lies inside the 800x600 window" \
+    {[winfo width .] <= 800 && [winfo height .] <= 600 && $sw < 1024 && $lx >= [winfo rootx .] &&
+     $ly >= [winfo rooty .] && $lx + $sw <= [winfo rootx .] + [winfo width .] &&
+     $ly + $sh <= [winfo rooty .] + [winfo height .] && [winfo width .view.image] == $sw} \
+    "window [winfo width .]x[winfo height .], image ${sw}x$sh at $lx,$ly"
+if {[auto_execok import] ne ""} {
+    set shotFile [file join $arg(-out) gui_fit_screenshot.png]
+    exec import -window root $shotFile
+    set shot [image create photo -file $shotFile]
+    # Every 8th pixel of the shown image, on the screen where the label is.
+    set same 0
+    set total 0
+    set lit 0
+    for {set y 0} {$y < $sh} {incr y 8} {
+        for {set x 0} {$x < $sw} {incr x 8} {
+            incr total
+            set want [$shownImage get $x $y]
+            set got [$shot get [expr {$lx + $x}] [expr {$ly + $y}]]
+            if {[::tcl::mathfunc::max {*}[lmap a $want b $got {expr {abs($a - $b)}}]] <= 2} {
+                incr same
+            }
+            if {[::tcl::mathop::+ {*}$want] > 60} {
+                incr lit
+            }
+        }
+    }
+    check "fit: the screenshot shows the scaled frame where the view is" {$same == $total && $lit > 0} \
+        "$same of $total pixels agree, $lit lit"
+    image delete $shot
+}
+wm geometry . {}
+set ::pvr::gui::opt(imagesz) 128x128
+set sentBefore $::pvr::gui::view::sent
+::pvr::gui::applyImageSize
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 30
+
+# The preset library in the Presets menu, and one of it renders.
+set menu .ctl.render.presets.m
+set labels {}
+for {set i 0} {$i <= [$menu index end]} {incr i} {
+    lappend labels [expr {[$menu type $i] eq "command" ? [$menu entrycget $i -label] : "-"}]
+}
+set missing {}
+foreach name {{ct bone} {ct skin} {ct muscle} {grey ramp} {cool to warm} viridis {black body}} {
+    if {$name ni $labels} {
+        lappend missing $name
+    }
+}
+check "presets: the menu lists the shipped library" {$missing eq {}} "missing $missing; menu $labels"
+set sentBefore $::pvr::gui::view::sent
+set before [pixels]
+$menu invoke [lsearch -exact $labels {cool to warm}]
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+check "presets: cool to warm renders a new frame" {[pixels] ne $before && $::pvr::gui::errors == 0} \
+    $::pvr::gui::statusText
+
+# Background, shading and step.
+set sentBefore $::pvr::gui::view::sent
+::pvr::gui::render::applyBackground #0000ff
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+check "background: the frame's corner is the chosen blue" {[$photo get 0 0] eq {0 0 255}} [$photo get 0 0]
+set sentBefore $::pvr::gui::view::sent
+set before [pixels]
+.ctl.render.shading invoke
+waitFor {$::pvr::gui::view::sent > $sentBefore && [idle]} 20
+check "shading: the checkbox turns it off and renders another frame" \
+    {[$::pvr::gui::session set -shading] eq "off" && [pixels] ne $before} [$::pvr::gui::session set -shading]
+set ::pvr::gui::render::step 0.25
+::pvr::gui::render::applyStep
+waitFor {[idle]} 20
+check "step: the entry sets -step" {[$::pvr::gui::session set -step] eq "0.25"} [$::pvr::gui::session set -step]
+
+# Save image: a PNG equal to the frame on screen.
+set saved [file join $arg(-out) saved_frame.png]
+file delete $saved
+::pvr::gui::render::saveImage $saved
+waitFor {[idle] && $::pvr::gui::render::saving eq ""} 20
+set worst 256
+if {[file exists $saved]} {
+    set read [image create photo -file $saved]
+    set worst [expr {[image width $read] == [image width $photo] ? 0 : 256}]
+    for {set y 0} {$y < [image height $photo] && $worst < 256} {incr y} {
+        for {set x 0} {$x < [image width $photo]} {incr x} {
+            foreach p [$photo get $x $y] q [$read get $x $y] {
+                set worst [expr {max($worst, abs($p - $q))}]
+            }
+        }
+    }
+    image delete $read
+}
+check "save image: writes a PNG equal to the frame" {$worst == 0 && [glob -nocomplain [file join $arg(-out) .pvr-save-*]] eq {}} \
+    "differs by $worst; status: $::pvr::gui::statusText"
+
+# Save animation: the rotation sequence as a GIF (pvrsh runs ffmpeg).
+if {[auto_execok ffmpeg] ne ""} {
+    set movie [file join $arg(-out) saved_movie.gif]
+    file delete $movie
+    set ::pvr::gui::opt(range) 0,3:12
+    ::pvr::gui::render::saveAnimation $movie
+    waitFor {[idle] && $::pvr::gui::render::saving eq ""} 30
+    check "save animation: writes the sequence as a GIF" \
+        {[file exists $movie] && [file size $movie] > 100 && [string match "saved saved_movie.gif*" $::pvr::gui::statusText]} \
+        $::pvr::gui::statusText
+}
+
+# Performance answers in human units: no long fractions.
+::pvr::gui::layout::show $::pvr::gui::session
+.layout.report.b.mem invoke
+set memoryText [.layout.report.t get 1.0 end]
+.layout.report.b.lat invoke
+set latencyText [.layout.report.t get 1.0 end]
+check "performance: memory in KB or MB, latency in ms, no long fractions" \
+    {[regexp {[0-9.]+ (KB|MB|GB)} $memoryText] && [regexp {[0-9.]+ ms} $latencyText] &&
+     ![regexp {\.[0-9]{5,}} $memoryText$latencyText]} "$memoryText\n$latencyText"
+check "performance: human units of bytes and seconds" \
+    {[::pvr::gui::layout::human bytes 1572864] eq "1.5 MB" && [::pvr::gui::layout::human model_seconds 0.0123456789] eq "12.35 ms"}
+
 # ---- Step 11: artifacts ----
 $photo write [file join $arg(-out) gui_frame.png] -format png
 check "artifact: gui_frame.png written" {[file size [file join $arg(-out) gui_frame.png]] > 100}
@@ -537,5 +669,40 @@ if {[catch steps message]} {
     check "no Tcl error" 0 "$message\n$::errorInfo"
 }
 check "no errors on the status line" {$::pvr::gui::errors == 0} "$::pvr::gui::errors errors"
+
+# ---- Step 12: a job that dies (issue 14, point 9) ----
+# The session's pvr-node is killed (a descendant of the pvrd this test
+# started, found by parent ids): the button offers Connect again, and
+# Render says so instead of pvrsh's Tcl advice.
+proc descendants {pid} {
+    set found {}
+    foreach child [split [string trim [exec sh -c "pgrep -P $pid || true"]] \n] {
+        if {$child ne ""} {
+            lappend found $child {*}[descendants $child]
+        }
+    }
+    return $found
+}
+if {[catch {
+    set nodes {}
+    foreach p [descendants [lindex [pid $pvrdChan] 0]] {
+        if {[catch {exec cat /proc/$p/comm} name] == 0 && [string match pvr-node* $name]} {
+            lappend nodes $p
+        }
+    }
+    check "dead job: the session's pvr-node is found" {[llength $nodes] > 0}
+    foreach p $nodes {
+        exec kill -KILL $p
+    }
+    set gone [waitFor {[.ctl.conn.open cget -text] eq "Connect"} 30]
+    check "dead job: the button says Connect again" {$gone} \
+        "button [.ctl.conn.open cget -text]; status: $::pvr::gui::statusText"
+    .ctl.view.render invoke
+    check "dead job: Render says to connect, without Tcl advice" \
+        {[string match "*press Connect*" $::pvr::gui::statusText] && ![string match "*use:*" $::pvr::gui::statusText]} \
+        $::pvr::gui::statusText
+} message]} {
+    check "dead job: no Tcl error" 0 "$message\n$::errorInfo"
+}
 puts "artifacts in $arg(-out)"
 finish
