@@ -116,6 +116,9 @@ CatalogListing listCatalog(const std::string& dataDir) {
       o.dataset.steps = source->steps();
       o.dataset.dims = {std::uint32_t(d.x), std::uint32_t(d.y), std::uint32_t(d.z)};
       o.dataset.dtype = std::string(core::scalarName(source->type()));
+      // Loadable, with a warning where it renders otherwise than the file
+      // says (issue 14, point 5: an oblique scan on the nearest axes).
+      o.dataset.note = source->caveat();
     } catch (const Error& e) {
       // A volume of a kind not rendered (float64, 4-D, ...) is listed with
       // the reason; a file that is no volume at all is left out.
@@ -127,9 +130,9 @@ CatalogListing listCatalog(const std::string& dataDir) {
       std::string why = e.what();
       if (const std::size_t at = why.find(c.real + ": "); at == 0) why = why.substr(c.real.size() + 2);
       o.dataset.note = "cannot be loaded: " + why;
-      for (char& ch : o.dataset.note)
-        if (ch == '\t' || ch == '\n') ch = ' ';
     }
+    for (char& ch : o.dataset.note)
+      if (ch == '\t' || ch == '\n') ch = ' ';
     opened.push_back(std::move(o));
   }
 
@@ -138,7 +141,8 @@ CatalogListing listCatalog(const std::string& dataDir) {
   for (const Opened& o : opened) {
     if (stepFiles.count(o.real)) continue;
     const Opened*& b = best[o.dataset.name];
-    const auto rank = [](const Opened* x) { return std::make_tuple(!x->dataset.note.empty(), x->order, x->dataset.file); };
+    // dtype is empty exactly when the file cannot be loaded (a note may be a warning).
+    const auto rank = [](const Opened* x) { return std::make_tuple(x->dataset.dtype.empty(), x->order, x->dataset.file); };
     if (!b) b = &o;
     else {
       const Opened* other = rank(&o) < rank(b) ? b : &o;

@@ -22,7 +22,10 @@ struct CatalogDataset {
   std::string format;  // the registry's name: "raw+json", "nrrd", "nifti", "series"
   std::array<std::uint32_t, 3> dims{0, 0, 0};  // 0 0 0 when it cannot be loaded
   std::string dtype;   // "int16", ...; empty when it cannot be loaded
-  std::string note;    // why it cannot be loaded (float64, 4-D, ...); empty when it can
+  // Why it cannot be loaded ("cannot be loaded: float64 ..."), or, when it
+  // can, what its rendering does not show as the file says (an oblique
+  // orientation, VolumeSource::caveat); empty when neither.
+  std::string note;
   bool operator==(const CatalogDataset&) const = default;
 };
 

@@ -78,6 +78,9 @@ void addDataset(const NodeState& state, std::vector<proto::KeyValue>& out) {
   const core::GridGeometry& grid = state.source->grid();
   const core::Vec3 lo = grid.domainMin(), hi = grid.domainMax();
   out.push_back({"bounds", list({lo.x, lo.y, lo.z, hi.x, hi.y, hi.z})});
+  // What the image does not show as the file says (an oblique scan on the
+  // nearest axes); the catalog lists the same text as the dataset's note.
+  if (const std::string caveat = state.source->caveat(); !caveat.empty()) out.push_back({"warning", caveat});
   addGrid(state, out);
   if (state.valueRange) out.push_back({"value_range", list({(*state.valueRange)[0], (*state.valueRange)[1]})});
   std::string points;

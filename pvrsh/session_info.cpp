@@ -16,7 +16,8 @@ Tcl_Obj* Session::infoObj() {
   // dict key -> status entry it comes from.
   static const std::pair<const char*, const char*> kKeys[] = {
       {"dataset", "dataset"}, {"dims", "dims"},   {"spacing", "spacing"},     {"origin", "origin"},
-      {"bounds", "bounds"},   {"dtype", "dtype"}, {"range", "value_range"}, {"histogram", "histogram"}};
+      {"bounds", "bounds"},   {"dtype", "dtype"}, {"range", "value_range"}, {"histogram", "histogram"},
+      {"warning", "warning"}};
   Tcl_Obj* d = Tcl_NewDictObj();
   bool loaded = false;
   for (const auto& [key, entry] : kKeys)

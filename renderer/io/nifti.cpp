@@ -131,6 +131,7 @@ class ScaledSource final : public VolumeSource {
     out.updateValueRange();
     return out;
   }
+  std::string caveat() const override { return stored_->caveat(); }
   std::string describe() const override {
     return stored_->describe() + " scaled to float32 (" + std::to_string(slope_) + " * v + " +
            std::to_string(inter_) + ")";

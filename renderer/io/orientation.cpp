@@ -54,6 +54,15 @@ std::string obliqueNote(const Orientation& o) {
   return text;
 }
 
+std::string obliqueWarning(const Orientation& o) {
+  if (o.obliqueDegrees == 0) return "";
+  char text[128];
+  std::snprintf(text, sizeof text,
+                "oblique orientation (%.3g degrees off the axes): rendered axis-aligned on the nearest signed axes",
+                o.obliqueDegrees);
+  return text;
+}
+
 namespace {
 
 class ReorientedSource final : public VolumeSource {
@@ -63,9 +72,14 @@ class ReorientedSource final : public VolumeSource {
   const GridGeometry& grid() const override { return o_.grid; }
   ScalarType type() const override { return inner_->type(); }
   bool canReadPartially() const override { return inner_->canReadPartially(); }
-  std::string describe() const override { return inner_->describe() + " (reoriented to its space)"; }
+  std::string describe() const override {
+    return inner_->describe() + (o_.reorders() ? " (reoriented to its space)" : "");
+  }
+  std::string caveat() const override { return obliqueWarning(o_); }
 
   Brick readBox(const NodeBox& owned, const NodeBox& stored) const override {
+    // An oblique file on its own axes needs no reordering, only its caveat.
+    if (!o_.reorders()) return inner_->readBox(owned, stored);
     checkReadBoxes(describe(), o_.grid, owned, stored);
     const Brick in = inner_->readBox(toFile(owned), toFile(stored));
     Brick out = Brick::forOverwrite(o_.grid, in.type(), owned, stored);
@@ -121,7 +135,7 @@ class ReorientedSource final : public VolumeSource {
 }  // namespace
 
 std::unique_ptr<VolumeSource> reoriented(std::unique_ptr<VolumeSource> inner, const Orientation& o) {
-  if (!o.reorders()) return inner;
+  if (!o.reorders() && o.obliqueDegrees == 0) return inner;
   return std::make_unique<ReorientedSource>(std::move(inner), o);
 }
 

@@ -43,10 +43,16 @@ Orientation orientationOf(const IndexFrame& frame, IVec3 dims, std::string_view 
 
 // `inner`, whose grid is the file's index grid, shown on `o.grid`: boxes
 // map to the file's, voxels are transposed and flipped after each read.
-// Returns inner itself when nothing reorders.
+// Its caveat() is obliqueWarning(o). Returns inner itself when nothing
+// reorders and the file is not oblique.
 std::unique_ptr<VolumeSource> reoriented(std::unique_ptr<VolumeSource> inner, const Orientation& o);
 
 // " (oblique by 12.3 degrees: shown on the nearest axes)", or "".
 std::string obliqueNote(const Orientation& o);
+
+// The warning the catalog, `list status` and `:s info` give for an oblique
+// file: "oblique orientation (12.3 degrees off the axes): rendered
+// axis-aligned on the nearest signed axes", or "" when it is not oblique.
+std::string obliqueWarning(const Orientation& o);
 
 }  // namespace pvr::core

@@ -70,6 +70,8 @@ class SeriesSource final : public VolumeSource {
   std::string describe() const override {
     return name_ + ": " + std::to_string(steps_.size()) + " steps of " + shapeText(grid(), type());
   }
+  // The steps share step 0's grid, so they share its orientation too.
+  std::string caveat() const override { return steps_[0].volume->caveat(); }
 
   int steps() const override { return int(steps_.size()); }
   double stepTime(int k) const override { return at(k).time; }

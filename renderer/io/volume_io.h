@@ -29,6 +29,10 @@ class VolumeSource {
   virtual Brick readBox(const NodeBox& owned, const NodeBox& stored) const = 0;
   // A short description for logs and catalogs ("ct.nhdr: 256x256x108 int16").
   virtual std::string describe() const = 0;
+  // What the rendering does not show as the file says, for a warning in the
+  // catalog, `list status` and `:s info` (an oblique orientation rendered
+  // on the nearest axes, orientation.h); empty when it shows it as it is.
+  virtual std::string caveat() const { return ""; }
 
   Brick readAll() const { return readBox(grid().allNodes(), grid().allNodes()); }
 

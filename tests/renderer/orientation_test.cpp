@@ -127,6 +127,9 @@ TEST_CASE("a NIfTI whose sform permutes and flips reads in scanner order, and an
   writeBytes(dir + "/q.nii", niftiBytes(q, file, false));
   const auto oblique = openVolumeFile(dir + "/q.nii");
   CHECK_THAT(oblique->describe(), Contains("q.nii (oblique by 30 degrees: shown on the nearest axes)"));
+  // The warning the catalog and status give (issue 14, point 5); a flip is rendered exactly.
+  CHECK(oblique->caveat() == "oblique orientation (30 degrees off the axes): rendered axis-aligned on the nearest signed axes");
+  CHECK(source->caveat().empty());
   CHECK(oblique->grid().dims == file.grid.dims);
   requirePattern(oblique->readAll(), file.type);
 }
