@@ -100,16 +100,10 @@ void Session::assembleAnimation(const Sequence& seq) {
   } else {
     Tcl_Obj* cmd = Tcl_NewListObj(0, nullptr);
     Tcl_IncrRefCount(cmd);
-    // MP4: H.264 in 4:2:0 (the one chroma layout every player takes; it
-    // needs even sides). GIF: one palette made for these frames.
-    const bool gif = animatedTarget_.size() >= 4 && animatedTarget_.compare(animatedTarget_.size() - 4, 4, ".gif") == 0;
-    const std::string filter = gif ? "split[a][b];[a]palettegen=stats_mode=full[p];[b][p]paletteuse=dither=sierra2_4a"
-                                   : "scale=trunc(iw/2)*2:trunc(ih/2)*2,format=yuv420p";
-    for (const std::string& a : {std::string("exec"), std::string("ffmpeg"), std::string("-y"), std::string("-loglevel"),
-                                 std::string("error"), std::string("-framerate"), std::string("10"),
-                                 std::string("-start_number"), std::to_string(firstFileNumber_), std::string("-i"), input,
-                                 std::string("-vf"), filter, animatedTarget_, std::string("2>@1")})
+    Tcl_ListObjAppendElement(nullptr, cmd, Tcl_NewStringObj("exec", -1));
+    for (const std::string& a : ffmpegArguments(animatedTarget_, input, firstFileNumber_, animationFps_))
       Tcl_ListObjAppendElement(nullptr, cmd, Tcl_NewStringObj(a.c_str(), -1));
+    Tcl_ListObjAppendElement(nullptr, cmd, Tcl_NewStringObj("2>@1", -1));
     if (Tcl_EvalObjEx(interp_, cmd, TCL_EVAL_GLOBAL) != TCL_OK)
       std::fprintf(stderr, "%s: ffmpeg could not write %s: %s\n", name_.c_str(), animatedTarget_.c_str(),
                    Tcl_GetStringResult(interp_));

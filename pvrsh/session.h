@@ -37,6 +37,7 @@
 
 #include "connection.h"
 #include "frame_image.h"
+#include "animation.h"
 #include "numbered_file.h"
 #include "reply_book.h"
 #include "scene_options.h"
@@ -116,6 +117,7 @@ class Session : public Connection::Listener {
   Tcl_Obj* notify_ = nullptr;    // command prefix; event and details appended
   NumberedFile files_;          // `image file`: the numbered PNGs; empty: none
   std::string animatedTarget_;  // .gif or .mp4 that ffmpeg assembles; empty: none
+  int animationFps_ = kDefaultFps;  // its frames per second (`image file F -fps N`)
   std::string dir_;
 
  private:

@@ -93,16 +93,27 @@ int closeCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   return TCL_OK;
 }
 
-// :s image window|callback|file|dir ?VALUE?  (no value: the current one)
+// :s image window|callback|file|dir ?VALUE?  (no value: the current one);
+// :s image file movie.gif|movie.mp4 -fps N  (the animation's frame rate)
 int imageCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   static const char* const kKinds[] = {"callback", "dir", "file", "window", nullptr};
-  if (objc != 3 && objc != 4) {
+  if (objc != 3 && objc != 4 && objc != 6) {
     Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
   }
   int kind = 0;
   if (Tcl_GetIndexFromObj(interp, objv[2], kKinds, "image target", 0, &kind) != TCL_OK)
     throw TclError({"PVR", "ARGS", "IMAGE"}, Tcl_GetStringResult(interp));
+  // The frame rate belongs to the animated file, so it is set with it and
+  // every `image file` without -fps goes back to the default; it is no
+  // `set` option because those are the server's scene, this is pvrsh's.
+  int fps = kDefaultFps;
+  if (objc == 6) {
+    if (kind != 2 || str(objv[4]) != "-fps")
+      throw TclError({"PVR", "ARGS", "IMAGE"}, "image: only \"image file FILE -fps N\" takes an option, got \"" +
+                                                   str(objv[4]) + "\" after " + str(objv[2]));
+    fps = fpsOf(str(objv[5]));
+  }
   if (objc == 3) {
     const std::string values[] = {"", s.dir_, s.animatedTarget_.empty() ? s.files_.pattern() : s.animatedTarget_,
                                   s.photo_};
@@ -130,11 +141,19 @@ int imageCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
       break;
     case 2:
       if (v.empty()) {
+        if (objc == 6) throw TclError({"PVR", "ARGS", "FPS"}, "image file: -fps needs a .gif or .mp4 file, got none");
         s.files_ = {};
         s.animatedTarget_.clear();
       } else {
-        s.files_ = numberedFileOf(v, s.animatedTarget_);
+        std::string animated;
+        NumberedFile files = numberedFileOf(v, animated);
+        if (objc == 6 && animated.empty())
+          throw TclError({"PVR", "ARGS", "FPS"},
+                         "image file: -fps is the frame rate of a .gif or .mp4 file; '" + v + "' writes PNG frames only");
+        s.files_ = files;
+        s.animatedTarget_ = animated;
       }
+      s.animationFps_ = fps;
       break;
     case 3:
       if (!v.empty()) {
@@ -440,8 +459,9 @@ const Subcommand kSubcommands[] = {
     {"cancel", cancelCmd, "", "stop the sequence in flight; returns the frames that will still come"},
     {"close", closeCmd, "", "end the session and its MPI job"},
     {"help", helpCmd, "?subcommand?", "this help; with a subcommand, its usage (and, for set, every option)"},
-    {"image", imageCmd, "window|callback|file|dir ?value?",
-     "where frames go: a Tk photo, a callback, numbered files or a directory (no value: the current one)"},
+    {"image", imageCmd, "window|callback|file|dir ?value? | file movie.gif|movie.mp4 -fps n",
+     "where frames go: a Tk photo, a callback, numbered files or a directory (no value: the current one);"
+     " -fps: the animation's frames per second, 1 to 120 (default 10)"},
     {"info", infoCmd, "", "the loaded dataset: dims, spacing, origin, bounds, dtype, range and histogram"},
     {"list", listCmd, "status|datasets ?-steps|-details?", "the session's status, or the server's datasets"},
     {"notify", notifyCmd, "?command?", "call COMMAND event details... on done, cancelled and error"},

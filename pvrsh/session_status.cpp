@@ -55,6 +55,7 @@ Tcl_Obj* Session::statusObj() {
   put("window", str(photo_));
   put("callback", callback_ ? callback_ : Tcl_NewObj());
   put("file", str(files_.pattern()));
+  put("fps", Tcl_NewIntObj(animationFps_));
   put("dir", str(dir_));
   put("frames_received", Tcl_NewWideIntObj(Tcl_WideInt(framesReceived_)));
   put("busy", Tcl_NewBooleanObj(!book_.sequences.empty()));
