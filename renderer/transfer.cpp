@@ -88,6 +88,18 @@ bool TransferTable::anyVisible(double lo, double hi) const {
   return visiblePrefix_[b + 1] - visiblePrefix_[a] > 0;
 }
 
+ExtinctionTable::ExtinctionTable(const TransferFunctionSpec& tf, double step) {
+  requireUsable(tf, step);
+  const TableDomain domain(tf, kEntries);
+  domain.mapping(scale_, offset_);
+  entries_.resize(kEntries);
+  for (int i = 0; i < kEntries; ++i) {
+    const Medium m = evaluateMedium(tf, domain.scalar(i));
+    const double depth = m.tau * step;
+    entries_[i] = {float(m.r * depth), float(m.g * depth), float(m.b * depth), float(depth)};
+  }
+}
+
 PreintegratedTable::PreintegratedTable(const TransferFunctionSpec& tf, double step) {
   requireUsable(tf, step);
   const TableDomain domain(tf, kEntries);

@@ -52,6 +52,30 @@ class TransferTable {
   std::vector<std::uint32_t> visiblePrefix_;  // visiblePrefix_[i] = visible entries below i
 };
 
+// The transfer function as an extinction medium, for mixing several
+// volumes (docs/scene.md, "Several volumes"): per entry the optical depth
+// of ONE ray step, d = tau h, and the linear colour weighted by it,
+// (c d, d) stored as (r, g, b, a). Depths of overlapping volumes add, and
+// so do their weighted colours; a sample of w steps then has opacity
+// 1 - exp(-w D) and premultiplied colour (sum c d) / D times that opacity.
+// Opacity 1 is evaluateMedium's saturating extinction: its depth
+// 1e30 h stays finite in float. Same table domain as TransferTable.
+class ExtinctionTable {
+ public:
+  static constexpr int kEntries = TransferTable::kEntries;
+
+  ExtinctionTable() = default;
+  ExtinctionTable(const TransferFunctionSpec& tf, double step);
+
+  float scale() const { return scale_; }
+  float offset() const { return offset_; }
+  const Rgba* entries() const { return entries_.data(); }  // kEntries entries
+
+ private:
+  float scale_ = 0, offset_ = 0;
+  std::vector<Rgba> entries_;
+};
+
 class PreintegratedTable {
  public:
   static constexpr int kEntries = 256;

@@ -88,67 +88,118 @@ Vec3 referenceLight(const Camera& camera, const ShadingSpec& shading) {
 
 RgbaD integrateRay(const ReferenceVolume& volume, const TransferFunctionSpec& tf, const Ray& ray,
                    Vec3 lightWorld, const ReferenceOptions& options) {
+  return integrateRay({ReferenceLayer{&volume, &tf}}, ray, lightWorld, options);
+}
+
+Image renderReference(const ReferenceVolume& volume, const TransferFunctionSpec& tf,
+                      const Camera& camera, const ReferenceOptions& options, ThreadPool& pool) {
+  return renderReference({ReferenceLayer{&volume, &tf}}, camera, options, pool);
+}
+
+namespace {
+
+// Extinction and emitted colour per unit opacity (c * lit plus white
+// specular) of one volume at index position u; tau 0 where it is empty.
+struct Emission {
+  double tau = 0;
+  double r = 0, g = 0, b = 0;
+};
+
+Emission emission(const ReferenceLayer& layer, Vec3 u, Vec3 lightWorld, Vec3 halfway,
+                  const ShadingSpec& sh) {
+  const double s = layer.volume->value(u);
+  if (!std::isfinite(s)) return {};  // non-finite data is empty space
+  const Medium m = evaluateMedium(*layer.tf, s);
+  if (!(m.tau > 0)) return {};
+  double lit = 1, spec = 0;
+  if (sh.enabled) {
+    const Vec3 g = layer.volume->gradient(u);
+    const double gg = dot(g, g);
+    lit = sh.ambient + sh.diffuse;  // zero or undefined gradient: lit head-on
+    if (gg > 1e-20 && std::isfinite(gg)) {
+      const Vec3 nrm = g / std::sqrt(gg);
+      lit = sh.ambient + sh.diffuse * std::abs(dot(nrm, lightWorld));
+      spec = sh.specular * std::pow(std::abs(dot(nrm, halfway)), sh.shininess);
+    }
+  }
+  return {m.tau, m.r * lit + spec, m.g * lit + spec, m.b * lit + spec};
+}
+
+}  // namespace
+
+RgbaD integrateRay(const std::vector<ReferenceLayer>& layers, const Ray& ray, Vec3 lightWorld,
+                   const ReferenceOptions& options) {
   if (!(options.step > 0))
     throw Error(ErrorCode::kInvalidArgument, "integrateRay: the substep must be > 0");
-  const Chord chord = domainChord(volume.grid(), ray);
-  if (!(chord.length() > 0)) return {};
-  const GridGeometry& grid = volume.grid();
+
+  // Each volume's chord, and the cuts where the set of volumes changes.
+  std::vector<Chord> chords;
+  std::vector<double> cuts;
+  for (const ReferenceLayer& layer : layers) {
+    chords.push_back(domainChord(layer.volume->grid(), ray));
+    if (!(chords.back().length() > 0)) continue;
+    cuts.push_back(chords.back().t0);
+    cuts.push_back(chords.back().t1);
+  }
+  std::sort(cuts.begin(), cuts.end());
 
   // Blinn-Phong half vector between the light and the viewer, who looks
   // back along the ray.
   const Vec3 toViewer = -ray.direction;
   const Vec3 sum = lightWorld + toViewer;
   const Vec3 halfway = length(sum) > 1e-9 ? normalize(sum) : lightWorld;
-  const ShadingSpec& sh = options.shading;
 
-  // Midpoint rule over n equal substeps, each attenuating exactly.
-  const double L = chord.length();
-  const double n = std::max(1.0, std::ceil(L / options.step));
-  const double dt = L / n;
   double transmittance = 1;
   RgbaD out;
-  for (double i = 0; i < n; ++i) {
-    const double t = chord.t0 + (i + 0.5) * dt;
-    const Vec3 world = ray.origin + ray.direction * t;
-    Vec3 u;
-    for (int a = 0; a < 3; ++a) u[a] = (world[a] - grid.origin[a]) / grid.spacing[a];
-    const double s = volume.value(u);
-    if (!std::isfinite(s)) continue;  // non-finite data is empty space
-    const Medium m = evaluateMedium(tf, s);
-    if (!(m.tau > 0)) continue;
-    const double alpha = -std::expm1(-m.tau * dt);
+  std::vector<std::size_t> active;
+  for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
+    const double a = cuts[c], b = cuts[c + 1];
+    active.clear();
+    for (std::size_t i = 0; i < layers.size(); ++i)
+      if (chords[i].length() > 0 && chords[i].t0 <= a && chords[i].t1 >= b) active.push_back(i);
+    if (!(b > a) || active.empty()) continue;
 
-    // Emitted colour per unit opacity: c * lit plus white specular.
-    double lit = 1, spec = 0;
-    if (sh.enabled) {
-      const Vec3 g = volume.gradient(u);
-      const double gg = dot(g, g);
-      lit = sh.ambient + sh.diffuse;  // zero or undefined gradient: lit head-on
-      if (gg > 1e-20 && std::isfinite(gg)) {
-        const Vec3 nrm = g / std::sqrt(gg);
-        lit = sh.ambient + sh.diffuse * std::abs(dot(nrm, lightWorld));
-        spec = sh.specular * std::pow(std::abs(dot(nrm, halfway)), sh.shininess);
+    // Midpoint rule over n equal substeps, each attenuating exactly.
+    const double L = b - a;
+    const double n = std::max(1.0, std::ceil(L / options.step));
+    const double dt = L / n;
+    for (double i = 0; i < n; ++i) {
+      const double t = a + (i + 0.5) * dt;
+      const Vec3 world = ray.origin + ray.direction * t;
+      Emission mixed;  // tau, and the tau-weighted colours
+      for (std::size_t v : active) {
+        const GridGeometry& grid = layers[v].volume->grid();
+        Vec3 u;
+        for (int x = 0; x < 3; ++x) u[x] = (world[x] - grid.origin[x]) / grid.spacing[x];
+        const Emission e = emission(layers[v], u, lightWorld, halfway, options.shading);
+        mixed.tau += e.tau;
+        mixed.r += e.tau * e.r;
+        mixed.g += e.tau * e.g;
+        mixed.b += e.tau * e.b;
       }
+      if (!(mixed.tau > 0)) continue;
+      const double alpha = -std::expm1(-mixed.tau * dt);
+      const double w = transmittance * alpha / mixed.tau;
+      out.r += w * mixed.r;
+      out.g += w * mixed.g;
+      out.b += w * mixed.b;
+      transmittance *= 1 - alpha;
+      if (transmittance < options.minTransmittance) break;
     }
-    const double w = transmittance * alpha;
-    out.r += w * (m.r * lit + spec);
-    out.g += w * (m.g * lit + spec);
-    out.b += w * (m.b * lit + spec);
-    transmittance *= 1 - alpha;
     if (transmittance < options.minTransmittance) break;
   }
   out.a = 1 - transmittance;
   return out;
 }
 
-Image renderReference(const ReferenceVolume& volume, const TransferFunctionSpec& tf,
-                      const Camera& camera, const ReferenceOptions& options, ThreadPool& pool) {
+Image renderReference(const std::vector<ReferenceLayer>& layers, const Camera& camera,
+                      const ReferenceOptions& options, ThreadPool& pool) {
   Image image = Image::fullFrame(camera.width(), camera.height());
   const Vec3 light = referenceLight(camera, options.shading);
   pool.parallelFor(std::size_t(camera.height()), [&](std::size_t row, int) {
     const int y = int(row);
     for (int x = 0; x < camera.width(); ++x) {
-      const RgbaD c = integrateRay(volume, tf, camera.ray(x, y), light, options);
+      const RgbaD c = integrateRay(layers, camera.ray(x, y), light, options);
       image.at(x, y) = {float(c.r), float(c.g), float(c.b), float(c.a)};
     }
   });

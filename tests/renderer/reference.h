@@ -90,6 +90,26 @@ RgbaD integrateRay(const ReferenceVolume& volume, const TransferFunctionSpec& tf
 Image renderReference(const ReferenceVolume& volume, const TransferFunctionSpec& tf,
                       const Camera& camera, const ReferenceOptions& options, ThreadPool& pool);
 
+// One volume of a scene of several: its voxels and its (resolved)
+// transfer function, both outliving the call.
+struct ReferenceLayer {
+  const ReferenceVolume* volume = nullptr;
+  const TransferFunctionSpec* tf = nullptr;
+};
+
+// One ray through several volumes that may overlap (docs/scene.md,
+// "Several volumes"). The ray is cut at every volume's chord ends; each
+// segment between two cuts, where a fixed set of volumes is present, is
+// integrated by the midpoint rule on equal substeps of at most
+// options.step: at a substep the extinctions of the volumes present add,
+// tau = sum tau_i, and the emitted colour is the extinction-weighted sum
+// of their (shaded) colours, sum tau_i e_i / tau. One layer gives the
+// one-volume integral above.
+RgbaD integrateRay(const std::vector<ReferenceLayer>& layers, const Ray& ray, Vec3 lightWorld,
+                   const ReferenceOptions& options);
+Image renderReference(const std::vector<ReferenceLayer>& layers, const Camera& camera,
+                      const ReferenceOptions& options, ThreadPool& pool);
+
 // Closed form of a homogeneous medium over a chord of length L:
 // alpha = 1 - exp(-tau L), colour = c * alpha.
 RgbaD constantMedium(const Medium& medium, double length);

@@ -1,0 +1,71 @@
+#include "kernel_setup.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pvr::core {
+
+void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocells) {
+  const GridGeometry& grid = brick.grid();
+  const NodeBox& own = brick.owned();
+  const NodeBox& st = brick.stored();
+  p.voxels = brick.bytes();
+  const IVec3 ext = st.extents();
+  p.strideY = ext.x;
+  p.strideZ = ext.x * ext.y;
+  p.base = -(st.lo.x + st.lo.y * p.strideY + st.lo.z * p.strideZ);
+  p.indices32 = st.nodeCount() < (std::int64_t(1) << 31) - 1;
+  for (int a = 0; a < 3; ++a) {
+    p.ownLo[a] = double(own.lo[a]);
+    p.ownHi[a] = double(own.hi[a]);
+    p.hiClosed[a] = own.hi[a] == grid.dims[a] - 1;
+    p.ownCellLo[a] = int(own.lo[a]);
+    p.ownCellHi[a] = int(std::max(own.lo[a], own.hi[a] - 1));
+    p.storedCellLo[a] = int(st.lo[a]);
+    p.storedCellHi[a] = int(std::max(st.lo[a], st.hi[a] - 1));
+    p.domainMax[a] = float(grid.dims[a] - 1);
+    p.invSpacing[a] = float(1.0 / grid.spacing[a]);
+    p.mcFirst[a] = int(macrocells.first()[a]);
+    p.mcCount[a] = int(macrocells.count()[a]);
+  }
+  p.distance = macrocells.distance();
+}
+
+void setOptions(KernelParams& p, const RenderOptions& options, const float* specularTable) {
+  p.earlyTermination = float(std::clamp(options.earlyTermination, 0.0, 1.0));
+  p.ambient = float(options.shading.ambient);
+  p.diffuse = float(options.shading.diffuse);
+  p.specular = float(options.shading.specular);
+  p.shininess = float(options.shading.shininess);
+  p.specularTable = specularTable;
+}
+
+std::vector<float> specularTable(double shininess) {
+  std::vector<float> table(kSpecularTableSize);
+  for (int i = 0; i < kSpecularTableSize; ++i)
+    table[i] = float(std::pow(double(i) / (kSpecularTableSize - 1), shininess));
+  return table;
+}
+
+RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step, const Vec3& lightWorld) {
+  RaySetup s;
+  for (int a = 0; a < 3; ++a) {
+    s.origin[a] = (ray.origin[a] - grid.origin[a]) / grid.spacing[a];
+    s.step[a] = ray.direction[a] * step / grid.spacing[a];
+    s.invStep[a] = s.step[a] != 0 ? 1.0 / s.step[a] : 0.0;
+  }
+  const double major = std::max({std::abs(s.step[0]), std::abs(s.step[1]), std::abs(s.step[2])});
+  s.leapPerMacrocell = double(MacrocellGrid::kSize) / major;
+  // Headlight by default: the light direction is fixed in camera space.
+  // The viewer looks back along the ray.
+  const Vec3 view = -ray.direction;
+  const Vec3 sum = lightWorld + view;
+  const Vec3 halfway = length(sum) > 1e-9 ? normalize(sum) : lightWorld;
+  for (int a = 0; a < 3; ++a) {
+    s.light[a] = float(lightWorld[a]);
+    s.halfway[a] = float(halfway[a]);
+  }
+  return s;
+}
+
+}  // namespace pvr::core

@@ -1,0 +1,33 @@
+// Filling the kernel's inputs (kernel.h): what a brick, the render options
+// and a camera ray say. One place for the single-volume caster
+// (raycaster.cpp) and the several-volume one (scene_renderer.cpp), so both
+// march a volume's samples from the same numbers.
+#pragma once
+
+#include <vector>
+
+#include "../brick.h"
+#include "../camera.h"
+#include "kernel.h"
+#include "macrocells.h"
+#include "raycaster.h"
+
+namespace pvr::core {
+
+// Voxels, strides, owned and stored boxes, cell clamps, spacing and
+// macrocells of `brick`; the classification table is the caller's.
+void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocells);
+
+// Early termination and shading parameters of `options`. `specularTable`
+// (specularTable() of the same shininess) must outlive p.
+void setOptions(KernelParams& p, const RenderOptions& options, const float* specularTable);
+
+// kSpecularTableSize values of x^shininess over [0, 1].
+std::vector<float> specularTable(double shininess);
+
+// The camera ray in `grid`'s index space, sample k at world distance
+// k * step, with the headlight's vectors: the light fixed in camera space,
+// the viewer looking back along the ray.
+RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step, const Vec3& lightWorld);
+
+}  // namespace pvr::core

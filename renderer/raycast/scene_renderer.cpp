@@ -1,0 +1,108 @@
+#include "scene_renderer.h"
+
+#include <chrono>
+#include <string>
+
+#include "../error.h"
+#include "kernel_setup.h"
+#include "mix_kernel.h"
+#include "tiles.h"
+
+namespace pvr::core {
+
+SceneRenderer::SceneRenderer(const std::vector<const Brick*>& volumes, ThreadPool* pool) {
+  if (volumes.empty()) throw Error(ErrorCode::kInvalidArgument, "SceneRenderer: a scene has at least one volume");
+  for (const Brick* brick : volumes) {
+    if (brick->stored() != brick->grid().allNodes())
+      throw Error(ErrorCode::kInvalidArgument, "SceneRenderer: a volume stores " + toString(brick->stored()) +
+                                                   ", not its whole grid " + toString(brick->grid().allNodes()));
+    Layer layer;
+    layer.brick = brick;
+    layer.renderer = std::make_unique<BrickRenderer>(*brick, pool);
+    layers_.push_back(std::move(layer));
+  }
+}
+
+void SceneRenderer::classify(const std::vector<SceneVolume>& volumes, const RenderOptions& options,
+                             ThreadPool* pool) {
+  if (volumes.size() != layers_.size())
+    throw Error(ErrorCode::kInternal, "SceneRenderer::classify: " + std::to_string(volumes.size()) +
+                                          " scene volumes for " + std::to_string(layers_.size()) + " bricks");
+  shown_.clear();
+  for (std::size_t i = 0; i < volumes.size(); ++i)
+    if (volumes[i].visible) shown_.push_back(int(i));
+  if (shown_.size() > std::size_t(kMaxMixedVolumes))
+    throw Error(ErrorCode::kInvalidArgument, "volumes: " + std::to_string(shown_.size()) +
+                                                 " are visible; at most " + std::to_string(kMaxMixedVolumes) +
+                                                 " mix in one rendering");
+  // One volume: its own renderer as configured. Several: plain tables for
+  // the macrocells (pre-integration does not mix) and extinction tables.
+  RenderOptions own = options;
+  if (shown_.size() > 1) own.preintegrated = false;
+  for (int i : shown_) {
+    layers_[i].renderer->classify(volumes[i].transfer, own, pool);
+    if (shown_.size() > 1) layers_[i].extinction = ExtinctionTable(volumes[i].transfer, options.step);
+  }
+  classifiedStep_ = options.step;
+  classifiedPreintegrated_ = options.preintegrated;
+}
+
+Image SceneRenderer::render(const Camera& camera, const RenderOptions& options, ThreadPool& pool,
+                            RenderStats* stats, const PixelRect* region) const {
+  if (options.step != classifiedStep_ || options.preintegrated != classifiedPreintegrated_)
+    throw Error(ErrorCode::kInternal, "SceneRenderer::render: classify() was called with other options");
+  if (shown_.size() == 1) return layers_[shown_.front()].renderer->render(camera, options, pool, stats, region);
+  return renderMixed(camera, options, pool, stats, region);
+}
+
+Image SceneRenderer::renderMixed(const Camera& camera, const RenderOptions& options, ThreadPool& pool,
+                                 RenderStats* stats, const PixelRect* region) const {
+  const auto started = std::chrono::steady_clock::now();
+  // The volumes with cells, their kernel parameters and the union of their
+  // screen rectangles.
+  const std::vector<float> specular = specularTable(options.shading.shininess);
+  MixedVolume volumes[kMaxMixedVolumes];
+  const GridGeometry* grids[kMaxMixedVolumes];
+  int n = 0;
+  PixelRect rect;
+  for (int i : shown_) {
+    const Layer& layer = layers_[i];
+    const GridGeometry& grid = layer.brick->grid();
+    if (grid.dims.x < 2 || grid.dims.y < 2 || grid.dims.z < 2) continue;  // no cells: nothing to show
+    MixedVolume& v = volumes[n];
+    setBrick(v.params, *layer.brick, layer.renderer->macrocells());
+    v.params.table = layer.extinction.entries();
+    v.params.tableEntries = ExtinctionTable::kEntries;
+    v.params.tableScale = layer.extinction.scale();
+    v.params.tableOffset = layer.extinction.offset();
+    setOptions(v.params, options, specular.data());
+    v.sample = pickMixSampler(layer.brick->type(), options.shading.enabled);
+    grids[n] = &grid;
+    const PixelRect r = camera.project(grid.domainMin(), grid.domainMax());
+    rect = n == 0 ? r : rect.unite(r);
+    ++n;
+  }
+  if (region) rect = rect.intersect(*region);
+  Image image(camera.width(), camera.height(), rect);
+  if (n == 0 || image.rect().empty()) {
+    if (stats) *stats = {};
+    return image;
+  }
+
+  const Vec3 lightWorld = normalize(camera.toWorld(options.shading.lightDirection));
+  const float earlyTermination = float(std::clamp(options.earlyTermination, 0.0, 1.0));
+  RenderStats counted;
+  renderTiles(image, options, pool, [&](int x, int y) {
+    const Ray ray = camera.ray(x, y);
+    RaySetup rays[kMaxMixedVolumes];
+    for (int i = 0; i < n; ++i) rays[i] = raySetup(ray, *grids[i], options.step, lightWorld);
+    return castMixedRay(volumes, rays, n, earlyTermination, MacrocellGrid::kShift);
+  }, counted);
+  if (stats) {
+    *stats = counted;
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  }
+  return image;
+}
+
+}  // namespace pvr::core
