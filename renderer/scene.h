@@ -159,12 +159,20 @@ nlohmann::json cameraSectionToJson(const CameraSpec& camera);
 // the narrower field of view. The one
 // place that computes it; docs/scene.md "camera" says the same.
 CameraSpec automaticCamera(const GridGeometry& grid, int width, int height);
+// The same for the box [lo, hi] (several volumes: their union); minSpacing
+// sizes a box that is a point.
+CameraSpec automaticCamera(Vec3 lo, Vec3 hi, double minSpacing, int width, int height);
 
 // Fills what depends on the volume: unit distance (the smallest spacing),
 // step (half of it) and, for an automatic camera, automaticCamera. Throws
 // pvr::Error for an invalid grid. Afterwards nothing is automatic.
 // Shading without "enabled" is resolved too (on for 3-D data).
 void resolveDefaults(Scene& scene, const GridGeometry& grid);
+// The same for a scene of several volumes, grids[i] being volume i's: each
+// volume's unit distance is its own smallest spacing; the step is half the
+// smallest spacing of all, the automatic camera frames the union of their
+// domains, shading is on when every one is 3-D. One grid: the form above.
+void resolveDefaults(Scene& scene, const std::vector<GridGeometry>& grids);
 
 // A white ramp of opacity 0 at `min` to 1 at `max` (a one-value range gets
 // a span of 1 above it): the transfer function of a scene that names none.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "error.h"
 #include "scene.h"
@@ -13,13 +15,17 @@ namespace pvr::core {
 using scene_json::numberText;
 
 CameraSpec automaticCamera(const GridGeometry& grid, int width, int height) {
+  return automaticCamera(grid.domainMin(), grid.domainMax(), grid.minSpacing(), width, height);
+}
+
+CameraSpec automaticCamera(Vec3 lo, Vec3 hi, double minSpacing, int width, int height) {
   constexpr double kFovYDeg = 30, kElevationDeg = 20, kAzimuthDeg = 30, kMargin = 1.05;
   constexpr double kDeg = std::numbers::pi / 180;
 
   // Fit the domain's bounding sphere, plus a margin, into the narrower of
   // the two fields of view. A one-node domain is a point: give it half a voxel.
   const double radius =
-      kMargin * std::max(0.5 * length(grid.domainMax() - grid.domainMin()), 0.5 * grid.minSpacing());
+      kMargin * std::max(0.5 * length(hi - lo), 0.5 * minSpacing);
   const double halfFovY = 0.5 * kFovYDeg * kDeg;
   const double aspect = double(width) / double(height);
   const double halfFovX = std::atan(std::tan(halfFovY) * aspect);
@@ -32,7 +38,7 @@ CameraSpec automaticCamera(const GridGeometry& grid, int width, int height) {
   CameraSpec cam;
   cam.projection = Projection::kPerspective;
   cam.fovYDeg = kFovYDeg;
-  cam.lookAt = grid.center();
+  cam.lookAt = (lo + hi) * 0.5;
   cam.eye = cam.lookAt + towardsEye * distance;
   cam.up = {0, 0, 1};
   cam.height = 0;
@@ -57,6 +63,43 @@ void resolveDefaults(Scene& scene, const GridGeometry& grid) {
   if (scene.shading.automatic) {
     // Gradients need three dimensions: a slice or a line stays unshaded.
     scene.shading.enabled = grid.dims.x > 1 && grid.dims.y > 1 && grid.dims.z > 1;
+    scene.shading.automatic = false;
+  }
+}
+
+void resolveDefaults(Scene& scene, const std::vector<GridGeometry>& grids) {
+  if (grids.size() != scene.volumes.size())
+    throw Error(ErrorCode::kInternal, "resolveDefaults: " + std::to_string(grids.size()) + " grids for " +
+                                          std::to_string(scene.volumes.size()) + " volumes");
+  if (grids.size() == 1) return resolveDefaults(scene, grids.front());
+  // Each volume's unit distance is its own voxel; the step, the camera and
+  // the step limit are over all of them (visible or not, so that showing
+  // or hiding one moves nothing).
+  double voxel = 0;
+  Vec3 lo, hi;
+  bool solid = true;
+  for (std::size_t i = 0; i < grids.size(); ++i) {
+    const GridGeometry& grid = grids[i];
+    grid.validate("volumes[" + std::to_string(i) + "] '" + scene.volumes[i].name + "'");
+    if (scene.volumes[i].transfer.unitDistance == 0) scene.volumes[i].transfer.unitDistance = grid.minSpacing();
+    voxel = i == 0 ? grid.minSpacing() : std::min(voxel, grid.minSpacing());
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = i == 0 ? grid.domainMin()[a] : std::min(lo[a], grid.domainMin()[a]);
+      hi[a] = i == 0 ? grid.domainMax()[a] : std::max(hi[a], grid.domainMax()[a]);
+    }
+    solid = solid && grid.dims.x > 1 && grid.dims.y > 1 && grid.dims.z > 1;
+  }
+  if (scene.sampling.step == 0) scene.sampling.step = 0.5 * voxel;
+  const double diagonal = length(hi - lo);
+  if (diagonal / scene.sampling.step > kMaxSamplesPerRay)
+    throw Error(ErrorCode::kInvalidArgument,
+                "sampling.step: " + numberText(scene.sampling.step) + " gives " + numberText(diagonal / scene.sampling.step) +
+                    " samples across the diagonal of the volumes' union (" + numberText(diagonal) + "); at most " +
+                    numberText(kMaxSamplesPerRay) + " are allowed, so the step must be at least " +
+                    numberText(diagonal / kMaxSamplesPerRay));
+  if (scene.camera.automatic) scene.camera = automaticCamera(lo, hi, voxel, scene.image.width, scene.image.height);
+  if (scene.shading.automatic) {
+    scene.shading.enabled = solid;
     scene.shading.automatic = false;
   }
 }

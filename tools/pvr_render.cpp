@@ -1,5 +1,6 @@
-// pvr-render: render one scene, or one volume file with defaults, in this
-// process, all cores.
+// pvr-render: render one scene (one volume or several, mixed as
+// overlapping media), or one volume file with defaults, in this process,
+// all cores.
 //
 //   pvr-render SCENE.json|VOLUME -o OUT.exr|OUT.png [options]   (--help lists them)
 //
@@ -24,6 +25,7 @@
 #include "image_io.h"
 #include "io/volume_io.h"
 #include "raycast/raycaster.h"
+#include "raycast/scene_renderer.h"
 #include "scene.h"
 #include "scene_volume.h"
 
@@ -137,33 +139,41 @@ int main(int argc, char** argv) {
   using namespace pvr::core;
   const Args args = parseArgs(argc, argv);
   try {
+    // Every volume of the scene, whole, in the scene's order.
     Scene scene;
-    std::unique_ptr<VolumeSource> source;
-    Brick volume;
+    std::vector<std::unique_ptr<VolumeSource>> sources;
+    std::vector<Brick> volumes;
     if (isSceneFile(args.scene)) {
       scene = loadSceneFile(args.scene);
-      source = openSceneVolume(scene.volumes.front().source);
-      // The scene's time step of a series (step 0, the volume itself, otherwise).
-      volume = source->step(scene.volumes.front().source.timestep).readAll();
+      for (const SceneVolume& v : scene.volumes) {
+        sources.push_back(openSceneVolume(v.source));
+        // The scene's time step of a series (step 0, the volume itself, otherwise).
+        volumes.push_back(sources.back()->step(v.source.timestep).readAll());
+      }
     } else {
-      source = openVolumeFile(args.scene);
-      volume = source->readAll();
+      sources.push_back(openVolumeFile(args.scene));
+      volumes.push_back(sources.back()->readAll());
       scene = sceneOfVolume(args.scene);
     }
     if (args.step > 0) scene.sampling.step = args.step;
     if (args.width > 0) scene.image.width = args.width, scene.image.height = args.height;
     if (args.preintegrated >= 0) scene.sampling.preintegrated = args.preintegrated == 1;
     if (args.shading >= 0) scene.shading.enabled = args.shading == 1;
-    resolveDefaults(scene, source->grid());
-    // The data's range fits the default ramp or stretches a preset (one
-    // rule for every program: resolveDataDefaults).
-    resolveDataDefaults(scene.volumes.front().transfer, volume.valueRange().min, volume.valueRange().max);
+    std::vector<GridGeometry> grids;
+    for (const auto& source : sources) grids.push_back(source->grid());
+    resolveDefaults(scene, grids);
+    // Each volume's data range fits its default ramp or stretches its
+    // preset (one rule for every program: resolveDataDefaults).
+    for (std::size_t i = 0; i < volumes.size(); ++i)
+      resolveDataDefaults(scene.volumes[i].transfer, volumes[i].valueRange().min, volumes[i].valueRange().max);
 
     RenderOptions options = renderOptionsFor(scene);
     if (args.skip >= 0) options.skipEmpty = args.skip == 1;
     ThreadPool pool(args.threads);
-    BrickRenderer renderer(volume);
-    renderer.classify(scene.volumes.front().transfer, options);
+    std::vector<const Brick*> bricks;
+    for (const Brick& v : volumes) bricks.push_back(&v);
+    SceneRenderer renderer(bricks);
+    renderer.classify(scene.volumes, options);
     const Camera camera(scene.camera, scene.image.width, scene.image.height);
 
     Image image;
@@ -176,7 +186,11 @@ int main(int argc, char** argv) {
     std::sort(seconds.begin(), seconds.end());
     const double median = seconds[seconds.size() / 2];
     writeImage(image, scene.image.background, args.output);
-    std::printf("%s: %s, %dx%d, %d threads\n", args.output.c_str(), source->describe().c_str(),
+    std::string described;
+    for (const int i : renderer.shown())
+      described += (described.empty() ? "" : " + ") + sources[std::size_t(i)]->describe();
+    if (described.empty()) described = "no visible volume";
+    std::printf("%s: %s, %dx%d, %d threads\n", args.output.c_str(), described.c_str(),
                 scene.image.width, scene.image.height, pool.size());
     std::printf("time per frame %.4f s (median of %d), %.1f M samples/s, %.1f M samples/s per thread\n",
                 median, args.frames, stats.samples / median * 1e-6,

@@ -134,3 +134,31 @@ TEST_CASE("a computation volume and its parameters parse and print back", "[scen
     CHECK_THAT(e.what(), Contains("volume.computation 'gray_scott': a computation runs on the ranks"));
   }
 }
+
+namespace pvr::core {
+
+// resolveDefaults over several grids: each volume's unit distance is its
+// own voxel, the step half the smallest voxel of all, the automatic camera
+// looks at the centre of the union of the domains.
+TEST_CASE("several volumes resolve their own unit distance, one step and a camera over their union",
+          "[scene]") {
+  Scene s;
+  s.volumes.resize(2);
+  GridGeometry a, b;
+  a.dims = {10, 10, 10};
+  b.dims = {5, 5, 5};
+  b.spacing = {0.5, 0.5, 0.5};
+  b.origin = {20, 0, 0};
+  s.shading.automatic = true;
+  resolveDefaults(s, std::vector<GridGeometry>{a, b});
+  CHECK(s.volumes[0].transfer.unitDistance == 1.0);
+  CHECK(s.volumes[1].transfer.unitDistance == 0.5);
+  CHECK(s.sampling.step == 0.25);
+  CHECK_FALSE(s.camera.automatic);
+  CHECK(s.camera.lookAt.x == 11.0);
+  CHECK(s.camera.lookAt.y == 4.5);
+  CHECK(s.camera.lookAt.z == 4.5);
+  CHECK(s.shading.enabled);
+}
+
+}  // namespace pvr::core
