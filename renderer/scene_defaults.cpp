@@ -14,6 +14,20 @@ namespace pvr::core {
 
 using scene_json::numberText;
 
+namespace {
+
+// Refuses a step that needs more than kMaxSamplesPerRay samples across
+// `diagonal` (named by `across` in the message).
+void checkSamplesPerRay(double step, double diagonal, const std::string& across) {
+  if (diagonal / step <= kMaxSamplesPerRay) return;
+  throw Error(ErrorCode::kInvalidArgument,
+              "sampling.step: " + numberText(step) + " gives " + numberText(diagonal / step) + " samples across " +
+                  across + " (" + numberText(diagonal) + "); at most " + numberText(kMaxSamplesPerRay) +
+                  " are allowed, so the step must be at least " + numberText(diagonal / kMaxSamplesPerRay));
+}
+
+}  // namespace
+
 CameraSpec automaticCamera(const GridGeometry& grid, int width, int height) {
   return automaticCamera(grid.domainMin(), grid.domainMax(), grid.minSpacing(), width, height);
 }
@@ -52,13 +66,7 @@ void resolveDefaults(Scene& scene, const GridGeometry& grid) {
   for (SceneVolume& v : scene.volumes)
     if (v.transfer.unitDistance == 0) v.transfer.unitDistance = voxel;
   if (scene.sampling.step == 0) scene.sampling.step = 0.5 * voxel;
-  const double diagonal = length(grid.domainMax() - grid.domainMin());
-  if (diagonal / scene.sampling.step > kMaxSamplesPerRay)
-    throw Error(ErrorCode::kInvalidArgument,
-                "sampling.step: " + numberText(scene.sampling.step) + " gives " + numberText(diagonal / scene.sampling.step) +
-                    " samples across the domain's diagonal (" + numberText(diagonal) + "); at most " +
-                    numberText(kMaxSamplesPerRay) + " are allowed, so the step must be at least " +
-                    numberText(diagonal / kMaxSamplesPerRay));
+  checkSamplesPerRay(scene.sampling.step, length(grid.domainMax() - grid.domainMin()), "the domain's diagonal");
   if (scene.camera.automatic) scene.camera = automaticCamera(grid, scene.image.width, scene.image.height);
   if (scene.shading.automatic) {
     // Gradients need three dimensions: a slice or a line stays unshaded.
@@ -90,13 +98,7 @@ void resolveDefaults(Scene& scene, const std::vector<GridGeometry>& grids) {
     solid = solid && grid.dims.x > 1 && grid.dims.y > 1 && grid.dims.z > 1;
   }
   if (scene.sampling.step == 0) scene.sampling.step = 0.5 * voxel;
-  const double diagonal = length(hi - lo);
-  if (diagonal / scene.sampling.step > kMaxSamplesPerRay)
-    throw Error(ErrorCode::kInvalidArgument,
-                "sampling.step: " + numberText(scene.sampling.step) + " gives " + numberText(diagonal / scene.sampling.step) +
-                    " samples across the diagonal of the volumes' union (" + numberText(diagonal) + "); at most " +
-                    numberText(kMaxSamplesPerRay) + " are allowed, so the step must be at least " +
-                    numberText(diagonal / kMaxSamplesPerRay));
+  checkSamplesPerRay(scene.sampling.step, length(hi - lo), "the diagonal of the volumes' union");
   if (scene.camera.automatic) scene.camera = automaticCamera(lo, hi, voxel, scene.image.width, scene.image.height);
   if (scene.shading.automatic) {
     scene.shading.enabled = solid;
