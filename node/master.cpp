@@ -38,9 +38,12 @@ void Master::serve() {
   }
 }
 
-void Master::publishStatus() {
-  link_.publishStatus(proto::StatusReply{statusEntries(state_, {running_ != 0, framesSent_, scene_.settings})});
+proto::StatusReply Master::status() const {
+  return proto::StatusReply{
+      statusEntries(state_, {running_ != 0, framesSent_, scene_.settings, scene_.doc.contains("camera")})};
 }
+
+void Master::publishStatus() { link_.publishStatus(status()); }
 
 void Master::handle(const proto::Decoded& frame) {
   try {
@@ -111,7 +114,7 @@ std::optional<proto::ProtocolError> Master::applyScene(const proto::SetScene& re
 }
 
 void Master::on(const proto::StatusRequest&, std::uint32_t id) {
-  send(proto::StatusReply{statusEntries(state_, {running_ != 0, framesSent_, scene_.settings, scene_.doc.contains("camera")})}, id);
+  send(status(), id);
 }
 
 void Master::on(const proto::RenderFrame&, std::uint32_t id) {

@@ -28,6 +28,9 @@ class Master {
   // Answers one request; an error it throws becomes the request's Error.
   void handle(const proto::Decoded& frame);
   // What the link thread answers a Status with while a render runs.
+  // The session's status, one answer whoever asks: a StatusRequest the
+  // master serves, or the snapshot the link thread answers during a render.
+  proto::StatusReply status() const;
   void publishStatus();
 
   // One handler per message the master serves, `id` the request's; the
