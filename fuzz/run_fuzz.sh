@@ -9,6 +9,9 @@
 #   PVR_FUZZ_BUILD_DIR  build directory (default build-fuzz at the repository root)
 #   PVR_FUZZ_RUNS       run each target for exactly this many executions
 #                       instead of SECONDS (bench/fuzz/run.sh: 10000000)
+#   PVR_FUZZ_MAX_LEN    the longest input in bytes (default 8192); a shorter
+#                       one makes a long run faster where large inputs cost
+#                       more than they find (the pvrsh target's 10 M run)
 # Prints one line per target:
 #   fuzz NAME: executions E, seconds S, exec/s R, corpus A -> B, findings F
 # Exit status: 0 when every run ended without a crash or sanitizer report,
@@ -33,6 +36,11 @@ shift $(( $# > 0 ? 1 : 0 ))
 runs=${PVR_FUZZ_RUNS:-}
 if [[ -n $runs ]] && ! [[ $runs =~ ^[0-9]+$ && $runs -gt 0 ]]; then
   echo "$0: PVR_FUZZ_RUNS must be a positive whole number, got '$runs'" >&2
+  exit 2
+fi
+max_len=${PVR_FUZZ_MAX_LEN:-8192}
+if ! [[ $max_len =~ ^[0-9]+$ && $max_len -gt 0 ]]; then
+  echo "$0: PVR_FUZZ_MAX_LEN must be a positive whole number, got '$max_len'" >&2
   exit 2
 fi
 
@@ -76,7 +84,7 @@ run_one() {
   seeds=$(ls "$corpus" | wc -l)
   before_artifacts=$(ls "$artifacts" | wc -l)
 
-  local args=(-max_len=8192 -timeout=10 -print_final_stats=1 -artifact_prefix="$artifacts/")
+  local args=(-max_len="$max_len" -timeout=10 -print_final_stats=1 -artifact_prefix="$artifacts/")
   [[ -f $root/fuzz/$name.dict ]] && args+=(-dict="$root/fuzz/$name.dict")
   if [[ -n $runs ]]; then args+=(-runs="$runs"); else args+=(-max_total_time="$seconds"); fi
 
