@@ -3,6 +3,8 @@
 #include <charconv>
 #include <cmath>
 
+#include "stall_limit.h"
+
 namespace pvr::node {
 
 namespace {
@@ -46,9 +48,9 @@ bool parseServerOptions(int argc, char** argv, ServerOptions& options, std::stri
     } else if (a == "--stall-timeout") {
       double seconds = 0;
       const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), seconds);
-      // Below a few heartbeats (one a second) every rank would look stalled.
-      if (ec != std::errc() || end != v.data() + v.size() || !std::isfinite(seconds) || seconds < 2 || seconds > 86400) {
-        error = "--stall-timeout takes seconds from 2 to 86400, not '" + v + "'";
+      if (ec != std::errc() || end != v.data() + v.size() || !std::isfinite(seconds) ||
+          !proto::stallSecondsInRange(seconds)) {
+        error = proto::stallTimeoutRefusal(v);
         return false;
       }
       options.stallSeconds = seconds;

@@ -5,6 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include "stall_limit.h"
+
 namespace pvr::node {
 
 struct ServerOptions {
@@ -20,7 +22,7 @@ struct ServerOptions {
   // A rank that makes no progress this long (four times as long while it
   // reads data) is reported by number and host, and the job ends
   // (rank_watch.h).
-  double stallSeconds = 30;
+  double stallSeconds = proto::kDefaultStallSeconds;
 };
 
 // Parses "--server --connect HOST:PORT --data-dir DIR [--fail-once STEP@RANK]...

@@ -7,6 +7,7 @@
 #include <charconv>
 
 #include "launcher.h"
+#include "stall_limit.h"
 
 namespace pvr::daemon {
 namespace {
@@ -113,9 +114,8 @@ std::optional<DaemonOptions> parseOptions(const std::vector<std::string>& args, 
     } else if (a == "--node") {
       o.node = v;
     } else if (a == "--stall-timeout") {
-      // The node's range: below a few heartbeats every rank would look stalled.
-      if (!toInt(v, 2, 86400, o.stallTimeout)) {
-        error = "--stall-timeout takes seconds from 2 to 86400, not '" + v + "'";
+      if (!toInt(v, proto::kMinStallSeconds, proto::kMaxStallSeconds, o.stallTimeout)) {
+        error = proto::stallTimeoutRefusal(v);
         return std::nullopt;
       }
     } else if (a == "--idle-timeout" || a == "--frame-timeout" || a == "--handshake-timeout") {

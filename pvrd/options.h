@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "stall_limit.h"
+
 namespace pvr::daemon {
 
 struct DaemonOptions {
@@ -28,7 +30,7 @@ struct DaemonOptions {
   double idleTimeout = 600;     // seconds without a client frame
   double frameTimeout = 10;     // seconds to finish a frame once started
   double handshakeTimeout = 10; // seconds from accept to an authenticated Hello
-  int stallTimeout = 30;        // seconds a rank may make no progress (pvr-node --stall-timeout)
+  int stallTimeout = proto::kDefaultStallSeconds;  // a rank without progress (pvr-node --stall-timeout)
   bool help = false;            // -h or --help: print kUsage, nothing else
 };
 

@@ -18,6 +18,16 @@ pid_t masterRank(const fs::path& dataDir) {
   return -1;
 }
 
+// Opens a session for `c` and stops its master rank (SIGSTOP); the rank's pid.
+pid_t openSessionAndStopMaster(const Daemon& d, Client& c) {
+  c.hello();
+  c.openSession();
+  const pid_t master = masterRank(d.dataDir);
+  REQUIRE(master > 0);
+  REQUIRE(::kill(master, SIGSTOP) == 0);
+  return master;
+}
+
 }  // namespace
 
 TEST_CASE("connections that never authenticate have their own limit, are closed after the handshake timeout and never keep a client out for long") {
@@ -86,11 +96,7 @@ TEST_CASE("a client that never completes the secure channel is closed after the 
 TEST_CASE("a master that stopped reading neither wedges the handler nor hides its client leaving") {
   Daemon d(makeDataDir("wedged"), {}, {}, logPath("wedged"));
   Client c(d.port);
-  c.hello();
-  c.openSession();
-  const pid_t master = masterRank(d.dataDir);
-  REQUIRE(master > 0);
-  REQUIRE(::kill(master, SIGSTOP) == 0);
+  const pid_t master = openSessionAndStopMaster(d, c);
   // Scenes of 1 MiB each until the master's socket and the handler's
   // buffer for it are full: the handler keeps reading and refuses the rest.
   const std::string padding(1 << 20, ' ');
@@ -119,11 +125,7 @@ TEST_CASE("a master that stopped reading neither wedges the handler nor hides it
 TEST_CASE("a stopped master rank is reported by number and host after the stall timeout and its job ends") {
   Daemon d(makeDataDir("stoppedmaster"), {"--stall-timeout", "2"}, {}, logPath("stoppedmaster"));
   Client c(d.port);
-  c.hello();
-  c.openSession();
-  const pid_t master = masterRank(d.dataDir);
-  REQUIRE(master > 0);
-  REQUIRE(::kill(master, SIGSTOP) == 0);
+  const pid_t master = openSessionAndStopMaster(d, c);
   const auto e = c.expectError(30);
   CHECK(e.code == proto::ErrorCode::kRankFailed);
   CHECK(e.text.find("rank 0 on 127.0.0.1 sent nothing, not even its heartbeat, for 2 s (stopped or hung)") !=
