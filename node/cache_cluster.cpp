@@ -19,7 +19,7 @@ int indexInCluster(const NodeState& state) {
 
 bool servedByCacheCluster(const NodeState& state, const ClusterPlan& render) {
   return render.cacheCluster >= 0 && state.source && state.source->canReadPartially() &&
-         state.settings.decomposition == Decomposition::kKd;
+         state.settings.decomposition != Decomposition::kBalanced;
 }
 
 void prepareCacheRank(NodeState& state) {
@@ -32,7 +32,7 @@ void prepareCacheRank(NodeState& state) {
     const ClusterPlan& render = state.layout.clusters[std::size_t(c)];
     if (!servedByCacheCluster(state, render)) continue;
     const int n = int(render.ranks.size());
-    const core::KdTree tree = core::KdTree::build(state.source->grid(), n, kSplitAxisRule);
+    const core::KdTree tree = core::KdTree::build(state.source->grid(), n, splitAxisRule(state.settings.decomposition));
     for (int i = mine; i < n; i += m) {
       NodeState::ServedRank& s = state.served[{c, i}];
       s.cache = std::make_unique<BrickCache>();

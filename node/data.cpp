@@ -242,7 +242,7 @@ void rebalanceIfNeeded(NodeState& state) {
   // new brick of the step on screen (or takes its share of a scatter).
   std::optional<core::KdTree> tree;
   comm::runAgreed(cluster, [&] {
-    tree = core::KdTree::buildBalanced(state.source->grid(), cluster.size(), kSplitAxisRule, content);
+    tree = core::KdTree::buildBalanced(state.source->grid(), cluster.size(), splitAxisRule(state.settings.decomposition), content);
   });
   const int step = state.current->step;
   if (state.source->canReadPartially()) {

@@ -59,7 +59,8 @@ Brick obtainBrick(const core::VolumeSource& source, const KdTree& tree, int ghos
 
 const std::vector<DecompositionEntry>& decompositions() {
   static const std::vector<DecompositionEntry> table{{"kd", Decomposition::kKd},
-                                                     {"balanced", Decomposition::kBalanced}};
+                                                     {"balanced", Decomposition::kBalanced},
+                                                     {"slabs", Decomposition::kSlabs}};
   return table;
 }
 
@@ -85,7 +86,7 @@ Distribution distributeBricks(const core::VolumeSource& source, const core::Scen
 
   // The k-d tree: the same on every rank (it depends only on the grid).
   std::optional<KdTree> tree;
-  runAgreed(comm, [&] { tree = KdTree::build(source.grid(), comm.size(), kSplitAxisRule); });
+  runAgreed(comm, [&] { tree = KdTree::build(source.grid(), comm.size(), splitAxisRule(decomposition)); });
 
   // Without a partial reader rank 0 holds the whole volume while it scatters.
   std::optional<Brick> whole;
@@ -106,7 +107,7 @@ Distribution distributeBricks(const core::VolumeSource& source, const core::Scen
       content = core::countContent(out.brick, table);
     });
     comm.allReduceSum(content.counts);
-    runAgreed(comm, [&] { tree = KdTree::buildBalanced(source.grid(), comm.size(), kSplitAxisRule, content); });
+    runAgreed(comm, [&] { tree = KdTree::buildBalanced(source.grid(), comm.size(), splitAxisRule(decomposition), content); });
     out.brick = Brick();  // release the first brick before reading the second
     out.brick = obtainBrick(source, *tree, ghostLayers, whole, comm);
   }

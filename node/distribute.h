@@ -25,9 +25,11 @@ namespace pvr::node {
 enum class Decomposition : std::uint8_t {
   kKd,        // equal cells per rank
   kBalanced,  // equal non-empty content per rank (decompose/content.h)
+  kSlabs,     // equal cells per rank in slabs along z: a raw file's bricks
+              // are then one run each, held as the file's own pages (no copy)
 };
 // Action arguments carry a Decomposition (protocol/field_codec.h).
-constexpr bool isWireValue(Decomposition d) { return d <= Decomposition::kBalanced; }
+constexpr bool isWireValue(Decomposition d) { return d <= Decomposition::kSlabs; }
 
 // The one list of decompositions and their names, in the order to list
 // them: runtime settings, pvr-node --batch, status and reports read it.
@@ -40,8 +42,10 @@ std::string_view decompositionName(Decomposition d);
 // Throws pvr::Error (kInvalidArgument) naming `name` and the known ones.
 Decomposition decompositionNamed(std::string_view name);
 
-// How every k-d tree of the node picks its split axes.
-constexpr core::SplitAxisRule kSplitAxisRule = core::SplitAxisRule::kAlternating;
+// How the k-d trees of a decomposition pick their split axes.
+constexpr core::SplitAxisRule splitAxisRule(Decomposition d) {
+  return d == Decomposition::kSlabs ? core::SplitAxisRule::kSlowest : core::SplitAxisRule::kAlternating;
+}
 
 struct Distribution {
   core::KdTree tree;

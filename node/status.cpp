@@ -105,7 +105,7 @@ std::uint64_t oneStepBytes(const NodeState& state) {
     // A master outside the render clusters: the first one's tree.
     for (const ClusterPlan& c : state.layout.clusters)
       if (c.role == proto::ClusterRole::kRender) {
-        tree = core::KdTree::build(grid, int(c.ranks.size()), kSplitAxisRule);
+        tree = core::KdTree::build(grid, int(c.ranks.size()), splitAxisRule(state.settings.decomposition));
         break;
       }
   }

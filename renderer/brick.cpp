@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <new>
+#include <utility>
 
 #include "error.h"
 #include "preprocess.h"
@@ -70,8 +71,32 @@ Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, co
     throw Error(ErrorCode::kInvalidArgument,
                 "brick: owned box " + toString(owned) + " must lie in stored box " +
                     toString(stored) + " inside the grid " + toString(grid.allNodes()));
-  data_.resize(checkedStorageBytes(stored, type) + kPaddingBytes);
+  storedBytes_ = checkedStorageBytes(stored, type);
+  data_.resize(storedBytes_ + kPaddingBytes);
   std::fill(data_.end() - kPaddingBytes, data_.end(), std::byte{0});
+}
+
+Brick Brick::lending(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored,
+                     std::shared_ptr<const std::byte> voxels) {
+  if (owned.empty() || !stored.contains(owned) || !grid.allNodes().contains(stored) || !voxels)
+    throw Error(ErrorCode::kInvalidArgument,
+                "brick: owned box " + toString(owned) + " must lie in stored box " + toString(stored) +
+                    " inside the grid " + toString(grid.allNodes()) + ", with voxels lent");
+  Brick brick;
+  brick.grid_ = grid;
+  brick.type_ = type;
+  brick.owned_ = owned;
+  brick.stored_ = stored;
+  brick.storedBytes_ = checkedStorageBytes(stored, type);
+  brick.lent_ = std::move(voxels);
+  return brick;
+}
+
+void Brick::ownStorage() {
+  data_.resize(storedBytes_ + kPaddingBytes);
+  std::memcpy(data_.data(), lent_.get(), storedBytes_);
+  std::fill(data_.end() - kPaddingBytes, data_.end(), std::byte{0});
+  lent_.reset();
 }
 
 Brick::Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored)
@@ -95,7 +120,7 @@ double Brick::valueAt(IVec3 node) const {
 void Brick::updateValueRange(ThreadPool* pool) {
   const auto start = std::chrono::steady_clock::now();
   const NodeBox counted = countedBox(owned_, grid_);
-  Preprocessed p = preprocessVoxels(type_, owned_, stored_, data_.data(), pool, &counted);
+  Preprocessed p = preprocessVoxels(type_, owned_, stored_, std::as_const(*this).bytes(), pool, &counted);
   range_ = p.range;
   bounds_ = std::move(p.bounds);
   histogram_ = std::move(p.histogram);

@@ -50,6 +50,13 @@ class Brick {
   // page of a gigabyte brick once more.
   static Brick forOverwrite(const GridGeometry& grid, ScalarType type, const NodeBox& owned,
                             const NodeBox& stored);
+  // A brick over voxels it does not own: `voxels` holds the stored box's
+  // voxels in storage order followed by kPaddingBytes readable bytes (a
+  // file's pages, io/byte_stream.h lend), kept alive by the pointer. Read
+  // in place; the first writable access copies them into storage of the
+  // brick's own.
+  static Brick lending(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored,
+                       std::shared_ptr<const std::byte> voxels);
 
   const GridGeometry& grid() const { return grid_; }
   ScalarType type() const { return type_; }
@@ -61,15 +68,18 @@ class Brick {
   std::byte* bytes() {
     bounds_.reset();
     histogram_.reset();
+    if (lent_) ownStorage();
     return data_.data();
   }
-  const std::byte* bytes() const { return data_.data(); }
-  std::size_t byteSize() const { return data_.size() - kPaddingBytes; }
+  const std::byte* bytes() const { return lent_ ? lent_.get() : data_.data(); }
+  std::size_t byteSize() const { return storedBytes_; }
+  // The voxels are a file's pages, not storage of the brick's own (lending).
+  bool lent() const { return bool(lent_); }
   // Storage ends with this many zero bytes, so the vector kernel may load a
   // 32-bit word at the last voxel of any scalar type.
   static constexpr std::size_t kPaddingBytes = 8;
   template <typename T> T* as() { return reinterpret_cast<T*>(bytes()); }
-  template <typename T> const T* as() const { return reinterpret_cast<const T*>(data_.data()); }
+  template <typename T> const T* as() const { return reinterpret_cast<const T*>(bytes()); }
 
   // Linear index into storage of a global node inside `stored`.
   std::size_t linearIndex(IVec3 node) const {
@@ -126,12 +136,16 @@ class Brick {
   };
   struct Unwritten {};
   Brick(const GridGeometry& grid, ScalarType type, const NodeBox& owned, const NodeBox& stored, Unwritten);
+  // Copies lent voxels into storage of the brick's own.
+  void ownStorage();
 
   GridGeometry grid_;
   ScalarType type_ = ScalarType::kUInt8;
   NodeBox owned_;
   NodeBox stored_;
-  std::vector<std::byte, UnwrittenAllocator<std::byte>> data_;
+  std::vector<std::byte, UnwrittenAllocator<std::byte>> data_;  // empty while lent_
+  std::shared_ptr<const std::byte> lent_;                         // voxels lent by a file, or null
+  std::size_t storedBytes_ = 0;                                   // the stored box's voxel bytes
   ValueRange range_;
   std::shared_ptr<const MacrocellBounds> bounds_;
   std::shared_ptr<const FineHistogram> histogram_;

@@ -145,6 +145,7 @@ class TreeBuilder {
 
   std::array<int, 3> axisOrder(const CellCounts& cells, int firstAxis) const {
     std::array<int, 3> order{firstAxis, (firstAxis + 1) % 3, (firstAxis + 2) % 3};
+    if (rule_ == SplitAxisRule::kSlowest) return {2, 1, 0};
     if (rule_ == SplitAxisRule::kLongest) {
       order = {0, 1, 2};
       std::stable_sort(order.begin(), order.end(), [&](int a, int b) {

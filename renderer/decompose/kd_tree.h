@@ -15,7 +15,11 @@
 
 namespace pvr::core {
 
-enum class SplitAxisRule { kAlternating, kLongest };
+// kAlternating: x, y, z in turn down the tree; kLongest: the region's
+// longest side; kSlowest: z (a file's slowest axis) first, then y, then x,
+// so bricks are whole slabs, each one run of the file, while the ranks
+// leave z cells to split.
+enum class SplitAxisRule { kAlternating, kLongest, kSlowest };
 
 struct KdNode {
   NodeBox box;            // nodes of this subtree's region

@@ -1,6 +1,8 @@
 #include "byte_stream.h"
 
 #include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -37,6 +39,30 @@ std::size_t FileStream::readSome(std::uint64_t offset, std::byte* dst, std::size
     done += std::size_t(got);
   }
   return done;
+}
+
+std::shared_ptr<const std::byte> FileStream::lend(std::uint64_t offset, std::size_t n, std::size_t padding) {
+  struct stat st {};
+  if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode) || n == 0) return nullptr;
+  const std::uint64_t size = std::uint64_t(st.st_size);
+  if (offset > size || n > size - offset) return nullptr;
+  const std::uint64_t page = std::uint64_t(::sysconf(_SC_PAGESIZE));
+  const std::uint64_t first = offset / page * page;
+  const std::size_t lead = std::size_t(offset - first);
+  const std::size_t fileBytes = (lead + n + page - 1) / page * page;         // whole pages of the range
+  const std::size_t total = (lead + n + padding + page - 1) / page * page;  // and of its padding
+  // Address space for range and padding, anonymous zero pages; the file's
+  // pages go over its start, so padding past the file's end reads zero
+  // instead of faulting.
+  void* region = ::mmap(nullptr, total, PROT_READ, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (region == MAP_FAILED) return nullptr;
+  if (::mmap(region, fileBytes, PROT_READ, MAP_SHARED | MAP_FIXED, fd_, off_t(first)) == MAP_FAILED) {
+    ::munmap(region, total);
+    return nullptr;
+  }
+  std::shared_ptr<const std::byte> whole(static_cast<const std::byte*>(region),
+                                         [total](const std::byte* p) { ::munmap(const_cast<std::byte*>(p), total); });
+  return {whole, whole.get() + lead};
 }
 
 void FileStream::willNeed(std::uint64_t offset, std::size_t n) {

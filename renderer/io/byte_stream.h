@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 
 namespace pvr::core {
@@ -25,6 +26,16 @@ class ByteStream {
   // them) keeps the disk busy instead of waiting on each run in turn.
   // A forward-only stream decodes in order anyway: it ignores the hint.
   virtual void willNeed(std::uint64_t /*offset*/, std::size_t /*n*/) {}
+  // Bytes [offset, offset + n) in place, read-only, followed by at least
+  // `padding` readable bytes, kept for as long as the pointer lives (beyond
+  // the stream); or null when the stream cannot lend them (a compressed
+  // stream, a kernel that refuses to map). A reader whose brick is one run
+  // of the file holds the file's own pages instead of a copy: no memory of
+  // its own to fault in and fill, nothing held twice.
+  virtual std::shared_ptr<const std::byte> lend(std::uint64_t /*offset*/, std::size_t /*n*/,
+                                                std::size_t /*padding*/) {
+    return nullptr;
+  }
 };
 
 // A file opened read-only for positioned reads; closes it on destruction.
@@ -41,6 +52,12 @@ class FileStream final : public ByteStream {
   void willNeed(std::uint64_t offset, std::size_t n) override;
   // Reads up to n bytes at offset; returns how many (fewer only at the end of the file).
   std::size_t readSome(std::uint64_t offset, std::byte* dst, std::size_t n);
+  // Maps the range read-only (MAP_SHARED: the page cache's own pages); the
+  // padding past it is the file's next bytes or zero pages. Checks the
+  // file still holds the range first: a file cut shorter while mapped
+  // faults (SIGBUS) where read() would have reported it, so a volume file
+  // must not be truncated while a session renders it.
+  std::shared_ptr<const std::byte> lend(std::uint64_t offset, std::size_t n, std::size_t padding) override;
   const std::string& where() const { return where_; }
 
  private:

@@ -6,6 +6,8 @@
 #include <cstring>
 #include <vector>
 
+#include <unistd.h>
+
 #include "byte_stream.h"
 #include "gzip_stream.h"
 #include "preprocess.h"
@@ -32,6 +34,16 @@ void swapBytesInPlace(std::byte* data, std::size_t count, std::size_t size) {
       std::memcpy(data + 4 * i, &v, 4);
     }
   }
+}
+
+// Reads one byte of every page of [p, p + n): the pages are in memory after.
+void touchPages(const std::byte* p, std::size_t n) {
+  const std::size_t page = std::size_t(::sysconf(_SC_PAGESIZE));
+  unsigned sum = 0;
+  for (std::size_t i = 0; i < n; i += page) sum += unsigned(p[i]);
+  if (n > 0) sum += unsigned(p[n - 1]);
+  // The compiler must not drop the loads.
+  asm volatile("" : : "r"(sum));
 }
 
 std::unique_ptr<ByteStream> openStream(const RawLayout& layout) {
@@ -96,7 +108,6 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
   using Clock = std::chrono::steady_clock;
   auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   checkReadBoxes(layout.dataPath, grid, owned, stored);
-  Brick brick = Brick::forOverwrite(grid, type, owned, stored);  // every voxel is read below
   const std::size_t size = scalarSize(type);
   const IVec3 d = grid.dims;
   const IVec3 e = stored.extents();
@@ -127,7 +138,6 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
   const bool swap = size > 1 && layout.bigEndian != (std::endian::native == std::endian::big);
   const NodeBox counted = countedBox(owned, grid);
   SlabPreprocessor pre(type, owned, stored, &counted);
-  std::byte* voxels = brick.bytes();
   // The file bytes of the group of slabs starting at z0: from its first
   // run to the end of its last.
   auto groupOffset = [&](std::int64_t z0) {
@@ -142,25 +152,39 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
   constexpr std::size_t kReadAheadBytes = std::size_t(128) << 20;
   const std::int64_t groupsAhead =
       std::max<std::int64_t>(1, std::int64_t(kReadAheadBytes / groupBytes(stored.lo.z)));
+  Brick brick;
   withHeaderNamed(layout, [&] {
     std::unique_ptr<ByteStream> stream = openStream(layout);
+    // A brick of whole slabs in the file's byte order is one run of the
+    // file: it keeps the file's pages (ByteStream::lend) instead of a copy.
+    std::shared_ptr<const std::byte> lent;
+    if (wholeSlabs && !swap)
+      lent = stream->lend(groupOffset(stored.lo.z), std::size_t(e.z) * slabBytes, Brick::kPaddingBytes);
+    brick = lent ? Brick::lending(grid, type, owned, stored, lent)
+                 : Brick::forOverwrite(grid, type, owned, stored);  // every voxel is read below
+    std::byte* voxels = lent ? nullptr : brick.bytes();
     std::int64_t announced = stored.lo.z;  // first group not yet announced
     for (std::int64_t z0 = stored.lo.z; z0 <= stored.hi.z; z0 += slabsPerGroup) {
       const std::int64_t z1 = std::min(stored.hi.z, z0 + slabsPerGroup - 1);
       for (; announced <= stored.hi.z && announced < z0 + groupsAhead * slabsPerGroup; announced += slabsPerGroup)
         stream->willNeed(groupOffset(announced), groupBytes(announced));
-      std::byte* group = voxels + std::size_t(z0 - stored.lo.z) * slabBytes;
+      const std::size_t at = std::size_t(z0 - stored.lo.z) * slabBytes;
       const auto readStart = Clock::now();
-      if (wholeSlabs) {
+      if (lent) {
+        // Bring the group's pages in (from the disk, or mapped from the
+        // cache) as the read, so preprocessing times only its own work.
+        touchPages(lent.get() + at, groupBytes(z0));
+      } else if (wholeSlabs) {
         const std::uint64_t node = std::uint64_t(z0 * d.y * d.x);
-        stream->read(layout.offset + node * size, group, std::size_t(z1 - z0 + 1) * slabBytes);
+        stream->read(layout.offset + node * size, voxels + at, std::size_t(z1 - z0 + 1) * slabBytes);
       } else if (spans) {
         const std::uint64_t node = std::uint64_t((z0 * d.y + stored.lo.y) * d.x + stored.lo.x);
         stream->read(layout.offset + node * size, span.data(), span.size());
         for (std::int64_t j = 0; j < e.y; ++j)
-          std::memcpy(group + std::size_t(j) * rowRunBytes, span.data() + std::size_t(j) * rowPitch, rowRunBytes);
+          std::memcpy(voxels + at + std::size_t(j) * rowRunBytes, span.data() + std::size_t(j) * rowPitch,
+                      rowRunBytes);
       } else {
-        std::byte* dst = group;
+        std::byte* dst = voxels + at;
         for (std::int64_t j = 0; j < runsY; ++j, dst += rowRunBytes) {
           const std::int64_t y = stored.lo.y + j;
           const std::uint64_t node = std::uint64_t((z0 * d.y + y) * d.x + stored.lo.x);
@@ -169,8 +193,8 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
       }
       brick.loadTimes().read += since(readStart);
       const auto preStart = Clock::now();
-      if (swap) swapBytesInPlace(group, std::size_t(z1 - z0 + 1) * slabBytes / size, size);
-      pre.add(group, z0, z1);
+      if (swap) swapBytesInPlace(voxels + at, std::size_t(z1 - z0 + 1) * slabBytes / size, size);
+      pre.add(lent ? lent.get() + at : voxels + at, z0, z1);
       brick.loadTimes().preprocess += since(preStart);
     }
   });

@@ -59,7 +59,7 @@ void checkEveryRankCount(const core::Brick& whole) {
   REQUIRE(total == std::uint64_t(whole.grid().allNodes().nodeCount()));
   for (int ranks : {1, 2, 3}) {
     CAPTURE(ranks);
-    const core::KdTree tree = core::KdTree::build(whole.grid(), ranks, node::kSplitAxisRule);
+    const core::KdTree tree = core::KdTree::build(whole.grid(), ranks, node::splitAxisRule(node::Decomposition::kKd));
     std::mutex m;
     std::vector<node::DataSummary> got;
     comm::runInProcess(ranks, [&](comm::Communicator& comm) {

@@ -45,7 +45,7 @@ TEST_CASE("settingsFrom names the key of a wrong value, type or name") {
     }
     return std::string("accepted");
   };
-  CHECK_THAT(refusal({{"decomposition", "octree"}}), Catch::Contains("runtime.decomposition") && Catch::Contains("kd, balanced"));
+  CHECK_THAT(refusal({{"decomposition", "octree"}}), Catch::Contains("runtime.decomposition") && Catch::Contains("kd, balanced, slabs"));
   CHECK_THAT(refusal({{"threads", "four"}}), Catch::Contains("runtime.threads"));
   CHECK_THAT(refusal({{"threads", 0}}), Catch::Contains("runtime.threads"));
   CHECK_THAT(refusal({{"pixels", 8}}), Catch::Contains("runtime.pixels: must be a string"));
@@ -58,10 +58,10 @@ TEST_CASE("settingsFrom names the key of a wrong value, type or name") {
 }
 
 TEST_CASE("every decomposition reads back from its name") {
-  REQUIRE(node::decompositions().size() == 2);
+  REQUIRE(node::decompositions().size() == 3);
   for (const auto& d : node::decompositions()) {
     CHECK(node::decompositionName(d.value) == d.name);
     CHECK(node::decompositionNamed(d.name) == d.value);
   }
-  CHECK_THROWS_WITH(node::decompositionNamed("octree"), Catch::Contains("known: kd, balanced"));
+  CHECK_THROWS_WITH(node::decompositionNamed("octree"), Catch::Contains("known: kd, balanced, slabs"));
 }

@@ -684,7 +684,7 @@ TEST_CASE_METHOD(Fixture, "scene patches are checked whole before and after the 
     strategies += entry.name;
   }
   CHECK(status["strategies"] == strategies);
-  CHECK(status["decompositions"] == "kd balanced");
+  CHECK(status["decompositions"] == "kd balanced slabs");
   CHECK(status["strategy"] == "binary-swap");
   CHECK(status["decomposition"] == "kd");
   CHECK(status["hosts"] == thisHost() + " " + thisHost());

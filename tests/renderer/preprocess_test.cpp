@@ -411,6 +411,46 @@ TEST_CASE("the raw reader reads long rows one call each and short rows in spans,
   }
 }
 
+TEST_CASE("a brick of whole slabs keeps the raw file's pages, equal to a copy, until it is written", "[preprocess][io]") {
+  // 64 x 64 x 8 uint16 nodes: 64 KiB, whole pages, so the last slab ends
+  // where the file ends and the padding past it is not the file's.
+  const std::string dir = test::scratchDir("preprocess_lent");
+  const GridGeometry grid = gridOf({64, 64, 8});
+  Brick whole(grid, ScalarType::kUInt16, grid.allNodes(), grid.allNodes());
+  std::uint16_t* v = whole.as<std::uint16_t>();
+  for (std::int64_t i = 0; i < grid.allNodes().nodeCount(); ++i) v[i] = std::uint16_t(i * 7919 % 65521);
+  whole.updateValueRange();
+  const auto source = openVolumeFile(writeRawJsonVolume(whole, dir, "slabs", "whole slabs"));
+  for (const NodeBox owned : {NodeBox{{0, 0, 0}, {63, 63, 3}}, NodeBox{{0, 0, 4}, {63, 63, 7}}}) {
+    CAPTURE(toString(owned));
+    const Brick lent = source->readBox(owned, owned.grown(1).intersect(grid.allNodes()));
+    const Brick copied = cropBrick(whole, owned, 1);
+    CHECK(lent.lent());
+    REQUIRE(lent.byteSize() == copied.byteSize());
+    CHECK(std::memcmp(lent.bytes(), copied.bytes(), lent.byteSize()) == 0);
+    CHECK(sameBounds(*lent.macrocellBounds(), *copied.macrocellBounds()));
+    checkRange(lent.valueRange(), copied.valueRange());
+    // The kernels may load a word at the last voxel: the padding is there.
+    for (std::size_t i = 0; i < Brick::kPaddingBytes; ++i) CHECK(lent.bytes()[lent.byteSize() + i] == std::byte{0});
+
+    // Writing gives the brick storage of its own; the file and a brick
+    // still lent stay as they were.
+    Brick written = lent;
+    written.as<std::uint16_t>()[0] = 1;
+    CHECK_FALSE(written.lent());
+    CHECK(written.as<std::uint16_t>()[0] == 1);
+    CHECK(std::memcmp(written.bytes() + 2, copied.bytes() + 2, lent.byteSize() - 2) == 0);
+    CHECK(lent.lent());
+    CHECK(std::memcmp(lent.bytes(), copied.bytes(), lent.byteSize()) == 0);
+  }
+  // Rows that are not whole, or bytes to swap, are copied.
+  const Brick half = source->readBox({{0, 0, 0}, {31, 63, 7}}, {{0, 0, 0}, {32, 63, 7}});
+  CHECK_FALSE(half.lent());
+  test::writeText(dir + "/slabs_be.json", "{\"dims\": [64, 64, 8], \"dtype\": \"uint16\", \"raw_file\": \"slabs.raw\", "
+                                          "\"spacing\": [1, 1, 1], \"endian\": \"big\"}");
+  CHECK_FALSE(openVolumeFile(dir + "/slabs_be.json")->readBox(grid.allNodes(), grid.allNodes()).lent());
+}
+
 TEST_CASE("a brick renders the same with the bounds it carries as with bounds the renderer computes", "[preprocess]") {
   const GridGeometry grid = gridOf({33, 30, 27});
   Brick carried(grid, ScalarType::kUInt16, grid.allNodes(), grid.allNodes());
