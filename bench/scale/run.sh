@@ -11,7 +11,7 @@
 # the columns are in bench/scale/README.md.
 #
 #   bench/scale/run.sh [--size N] [--ranks "1 2 4 8"] [--frames F] [--no-series] [--series-only]
-#                      [BUILD_DIR]                  (default: build)
+#                      [--decomposition kd|balanced|slabs] [BUILD_DIR]   (default: build, kd)
 # Environment: PVR_SCALE_DATA (data directory, outside the repository;
 # default /work/scale-data), PVR_SCALE_SERIES_SIZE (256), PVR_SCALE_STEPS
 # (50), PVR_SCALE_CACHEMEM (read-ahead budget in MB, 4096), PVR_SCALE_DROP
@@ -24,7 +24,7 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
-size=2048 ranks="1 2 4 8" frames=20 static=1 series=1 build=$root/build
+size=2048 ranks="1 2 4 8" frames=20 static=1 series=1 build=$root/build decomposition=kd
 while [ $# -gt 0 ]; do
   case $1 in
     --size) size=$2; shift 2 ;;
@@ -32,6 +32,7 @@ while [ $# -gt 0 ]; do
     --frames) frames=$2; shift 2 ;;
     --no-series) series=0; shift ;;
     --series-only) static=0; shift ;;
+    --decomposition) decomposition=$2; shift 2 ;;
     -*) echo "run.sh: unknown option $1" >&2; exit 2 ;;
     *) build=$1; shift ;;
   esac
@@ -100,6 +101,7 @@ for key in ("ambient", "diffuse", "specular", "shininess"):
 print(" ".join(out))
 PY
 )
+settings="$settings -decomposition $decomposition"
 
 # pvrd on an ephemeral port over the data directory; its first stdout
 # line names the port. Stopped on exit.
@@ -135,7 +137,7 @@ batch() {
   local n=$1 cache=$2 readfile=$3 voxels=$4 scene=$5 stats=$data/batch-stats.csv
   local start end
   start=$(now)
-  mpirun --oversubscribe --bind-to none -np "$n" "$node" --batch "$scene" -o "$data/batch.png" \
+  mpirun --oversubscribe --bind-to none -np "$n" "$node" --decomposition "$decomposition" --batch "$scene" -o "$data/batch.png" \
     --stats "$stats" >> "$log"
   end=$(now)
   /usr/bin/python3 - "$stats" "$n" "$cache" "$voxels" "$(echo "$end - $start" | bc -l)" "$readfile" >> "$csv" <<'PY'
