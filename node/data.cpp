@@ -192,7 +192,7 @@ Reload openSeveral(NodeState& state, core::Scene scene) {
   std::vector<std::string> keys(n);
   std::vector<std::unique_ptr<core::VolumeSource>> opened(n);
   std::vector<const core::VolumeSource*> sources(n);
-  bool changed = !state.source || state.moreSources.size() + 1 != n;
+  bool changed = !state.source || !state.sourcesForSceneBricks || state.moreSources.size() + 1 != n;
   for (std::size_t i = 0; i < n; ++i) {
     keys[i] = volumeKeyOf(scene.volumes[i].source);
     const bool same = i == 0 ? state.source && keys[0] == state.volumeKey
@@ -225,6 +225,7 @@ Reload openSeveral(NodeState& state, core::Scene scene) {
     state.volumeKey = keys[0];
     state.moreKeys.assign(keys.begin() + 1, keys.end());
     state.volumeRanges.assign(n, std::nullopt);
+    state.sourcesForSceneBricks = true;
   }
   const bool stepChanged = scene.volumes.front().source.timestep != state.scene.volumes.front().source.timestep;
   const bool lengthChanged = options.step != state.renderOptions.step;
@@ -244,10 +245,10 @@ Reload openSeveral(NodeState& state, core::Scene scene) {
 
 Reload openScene(NodeState& state, const std::string& sceneJson) {
   core::Scene scene = core::parseScene(nlohmann::json::parse(sceneJson), state.dataDir);
-  if (scene.volumes.size() > 1) return openSeveral(state, std::move(scene));
+  if (needsSceneBricks(scene)) return openSeveral(state, std::move(scene));
   const std::string key = volumeKeyOf(scene.volumes.front().source);
   // After several volumes, one reads its bricks again even if it was the first.
-  const bool changed = key != state.volumeKey || !state.source || !state.moreSources.empty();
+  const bool changed = key != state.volumeKey || !state.source || state.sourcesForSceneBricks;
   std::unique_ptr<core::VolumeSource> source;
   const core::VolumeSource* grid = state.source.get();
   if (changed) {
@@ -268,6 +269,7 @@ Reload openScene(NodeState& state, const std::string& sceneJson) {
     state.moreSources.clear();
     state.moreKeys.clear();
     state.volumeRanges.clear();
+    state.sourcesForSceneBricks = false;
   }
   const bool stepChanged = scene.volumes.front().source.timestep != state.scene.volumes.front().source.timestep;
   state.scene = scene;

@@ -152,7 +152,7 @@ PreparedFrame prepareSeveral(const core::Scene& sceneIn, const FrameOptions& opt
 
 PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& options,
                            comm::Communicator& comm) {
-  if (sceneIn.volumes.size() > 1) return prepareSeveral(sceneIn, options, comm);
+  if (needsSceneBricks(sceneIn)) return prepareSeveral(sceneIn, options, comm);
   PreparedFrame prepared;
   FrameResult& result = prepared.frame;
   RankReport& report = prepared.report;

@@ -7,6 +7,10 @@
 
 namespace pvr::node {
 
+bool needsSceneBricks(const core::Scene& scene) {
+  return scene.volumes.size() > 1 || !scene.volumes.front().visible;
+}
+
 std::uint64_t SceneBricks::bytes() const {
   std::uint64_t sum = 0;
   for (const auto& b : bricks)

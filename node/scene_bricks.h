@@ -6,8 +6,8 @@
 // and holds, of every volume, the nodes the ray caster reads for the parts
 // of rays in that region (core::volumeBoxFor), read through the same
 // readers and scatter as one volume's bricks (distribute.h). Compositing
-// takes the tree as for one volume. A scene of one volume never comes
-// here: it keeps its own decomposition, bit for bit.
+// takes the tree as for one volume. A scene of one visible volume never
+// comes here: it keeps its own decomposition, bit for bit.
 #pragma once
 
 #include <memory>
@@ -24,6 +24,10 @@
 #include "scene.h"
 
 namespace pvr::node {
+
+// Whether a scene renders through SceneBricks: several volumes, or one
+// that is hidden (the one-volume path shows its volume whatever it says).
+bool needsSceneBricks(const core::Scene& scene);
 
 struct SceneBricks {
   core::KdTree tree;  // over core::unionGrid(grids), one leaf per rank

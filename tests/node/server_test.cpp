@@ -1043,7 +1043,8 @@ TEST_CASE_METHOD(Fixture, "the master sends Heartbeat frames to the handler, req
 // overlaps one corner of it. Each frame equals the whole scene mixed in
 // one process within 1e-5 (the rendering contract's tolerance for bricks,
 // tests/renderer/raycast_mixed_bricks_test.cpp), on 1, 3 and 4 ranks; a
-// volume hidden, then removed, by name; status lists the volumes.
+// volume hidden, then removed, by name, then the last one hidden and
+// shown again; status lists the volumes.
 TEST_CASE_METHOD(Fixture, "several volumes render as one process mixes them, and patches by name hide and remove them", "[volumes]") {
   nlohmann::json doc = nlohmann::json::parse(R"({
     "volumes": [
@@ -1088,6 +1089,16 @@ TEST_CASE_METHOD(Fixture, "several volumes render as one process mixes them, and
     nlohmann::json alone = doc;
     alone["volumes"].erase(1);
     const SceneReference one(alone);
+    checkFrames(job, id, 1, [&](int) { return one.frame(); });
+
+    // The last volume hidden shows nothing; shown again, it is back.
+    job.send(proto::SetScene{"", R"({"volumes": {"phantom": {"visible": false}}})"});
+    job.expect<proto::Ok>();
+    id = job.send(proto::RenderFrame{});
+    checkFrames(job, id, 1, [&](int) { return core::Image::fullFrame(64, 64); });
+    job.send(proto::SetScene{"", R"({"volumes": {"phantom": {"visible": true}}})"});
+    job.expect<proto::Ok>();
+    id = job.send(proto::RenderFrame{});
     checkFrames(job, id, 1, [&](int) { return one.frame(); });
     CHECK(job.close());
   }
