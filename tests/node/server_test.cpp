@@ -1103,3 +1103,37 @@ TEST_CASE_METHOD(Fixture, "several volumes render as one process mixes them, and
     CHECK(job.close());
   }
 }
+
+// A time series among several volumes (docs/scene.md, "Several volumes"):
+// the series shows the scene's timestep and each frame of a time request
+// its own step, the single volume beside it every time; a timestep past
+// the longest series is refused with checkTimestep's words.
+TEST_CASE_METHOD(Fixture, "a series among several volumes shows each step beside the other volume", "[volumes][series]") {
+  const auto docAt = [](const std::string& run) {
+    return nlohmann::json{
+        {"volumes",
+         {{{"name", "run"}, {"dataset", run},
+           {"transfer_function", {{"points", {{0, 0, 0, 0, 0}, {0.15, 0.3, 0.5, 1, 0.05}, {0.3, 1, 0.8, 0.3, 0.3}, {1, 1, 1, 1, 0.6}}}}}},
+          {{"name", "field"}, {"procedural", "marschner-lobb"}, {"dims", {20, 20, 20}}, {"spacing", {1.5, 1.5, 1.5}},
+           {"transfer_function", {{"points", {{0, 0.1, 0.3, 0.9, 0}, {0.55, 0.1, 0.3, 0.9, 0}, {0.7, 0.3, 0.6, 1, 0.05}, {1, 0.8, 0.9, 1, 0.2}}}}}}}},
+        {"image", {{"width", 48}, {"height", 48}}},
+        {"shading", {{"enabled", true}}}};
+  };
+  Job job(3, {});
+  job.send(proto::SessionOpen{3, {}, ""});
+  job.expect<proto::SessionReady>();
+  nlohmann::json doc = docAt(kSeries);
+  doc["timestep"] = 2;
+  job.send(proto::SetScene{"", doc.dump()});
+  job.expect<proto::Ok>();
+  auto id = job.send(proto::RenderFrame{});
+  const SceneReference step2(docAt(stepFile(2)));
+  checkFrames(job, id, 1, [&](int) { return step2.frame(); });
+
+  id = job.send(proto::RenderTimeSteps{0, 3, 1});
+  checkFrames(job, id, 4, [&](int k) { return SceneReference(docAt(stepFile(k))).frame(); });
+
+  job.send(proto::SetScene{"", R"({"timestep": 4})"});
+  CHECK_THAT(job.expectError().text, Catch::Contains("timestep 4: series.series.json has 4 time steps (0..3)"));
+  CHECK(job.close());
+}
