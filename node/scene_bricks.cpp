@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "distribute.h"
+#include "preprocess.h"
 #include "scene_volume.h"
 
 namespace pvr::node {
@@ -60,6 +61,14 @@ SceneBricks distributeScene(const std::vector<const core::VolumeSource*>& source
     out.readPartially = out.readPartially && source.canReadPartially();
     const auto boxOf = [&](int rank) { return core::volumeBoxFor(grid, core::regionOf(out.tree, rank), step); };
     out.bricks.push_back(obtainBrick(source, boxOf, 0, whole, comm));
+    // The histogram's counts: the region's own nodes, one more pass.
+    std::shared_ptr<const core::FineHistogram> counted;
+    const core::Brick* brick = out.brick(i);
+    const core::NodeBox mine = core::nodesIn(grid, out.region);
+    if (brick && !mine.empty())
+      counted = core::preprocessVoxels(brick->type(), brick->owned(), brick->stored(), brick->bytes(), nullptr, &mine)
+                    .histogram;
+    out.counted.push_back(std::move(counted));
   }
   return out;
 }
@@ -69,7 +78,7 @@ std::vector<std::optional<DataSummary>> summarizeVolumes(comm::Communicator& com
   std::vector<std::optional<DataSummary>> out;
   for (std::size_t i = 0; i < volumes; ++i) {
     const core::Brick* brick = bricks && i < bricks->bricks.size() ? bricks->brick(i) : nullptr;
-    out.push_back(summarizeData(comm, brick, counts && brick));
+    out.push_back(summarizeData(comm, brick, counts && brick ? bricks->counted[i].get() : nullptr));
   }
   return out;
 }

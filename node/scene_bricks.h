@@ -34,6 +34,9 @@ struct SceneBricks {
   core::WorldRegion region;
   std::vector<core::GridGeometry> grids;         // volume i's grid
   std::vector<std::optional<core::Brick>> bricks;  // volume i's nodes around the region; none when far
+  // Volume i's fine counts of its nodes in the region (core::nodesIn):
+  // bricks overlap, these do not. Null where the brick holds none.
+  std::vector<std::shared_ptr<const core::FineHistogram>> counted;
   std::unique_ptr<core::SceneRenderer> renderer;   // over the bricks (makeRenderer)
   bool readPartially = true;        // every volume was read box by box (else rank 0 scattered some)
   std::uint64_t rootReadBytes = 0;  // the most rank 0 held of one volume while scattering
@@ -61,10 +64,10 @@ void checkSceneTimestep(const core::Scene& scene, const std::vector<const core::
 SceneBricks distributeScene(const std::vector<const core::VolumeSource*>& sources, double step,
                             comm::Communicator& comm);
 
-// Collective over `comm`: each volume's DataSummary (summarizeData; the
-// histogram counts brick margins that overlap a neighbour's twice, so it
-// is a picture of the distribution, not a census). `bricks` may be null
-// (a rank holding no data); every rank passes the same volume count.
+// Collective over `comm`: each volume's DataSummary (summarizeData over
+// SceneBricks::counted, so each node counts once, as a serial count of
+// the whole volume). `bricks` may be null (a rank holding no data); every
+// rank passes the same volume count.
 std::vector<std::optional<DataSummary>> summarizeVolumes(comm::Communicator& comm, const SceneBricks* bricks,
                                                          std::size_t volumes, bool counts);
 

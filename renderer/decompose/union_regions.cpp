@@ -7,6 +7,17 @@
 
 namespace pvr::core {
 
+namespace {
+
+// Narrows box on `axis` to [lo, hi], node indices as doubles (infinite or
+// far outside for an unbounded face); empty when they miss the box.
+void clipAxis(NodeBox& box, int axis, double lo, double hi) {
+  if (lo > double(box.lo[axis])) box.lo[axis] = lo > double(box.hi[axis]) ? box.hi[axis] + 1 : std::int64_t(lo);
+  if (hi < double(box.hi[axis])) box.hi[axis] = hi < double(box.lo[axis]) ? box.lo[axis] - 1 : std::int64_t(hi);
+}
+
+}  // namespace
+
 GridGeometry unionGrid(const std::vector<GridGeometry>& grids) {
   if (grids.empty()) throw Error(ErrorCode::kInvalidArgument, "unionGrid: no volumes");
   Vec3 lo = grids.front().domainMin(), hi = grids.front().domainMax(), spacing = grids.front().spacing;
@@ -48,8 +59,18 @@ NodeBox volumeBoxFor(const GridGeometry& grid, const WorldRegion& region, double
     // In doubles first: an infinite face keeps the grid's own end.
     const double lo = std::floor((region.lo[a] - grid.origin[a]) / grid.spacing[a] - reach) - double(kLayers);
     const double hi = std::ceil((region.hi[a] - grid.origin[a]) / grid.spacing[a] + reach) + double(kLayers);
-    if (lo > double(box.lo[a])) box.lo[a] = lo > double(box.hi[a]) ? box.hi[a] + 1 : std::int64_t(lo);
-    if (hi < double(box.hi[a])) box.hi[a] = hi < double(box.lo[a]) ? box.lo[a] - 1 : std::int64_t(hi);
+    clipAxis(box, a, lo, hi);
+  }
+  return box;
+}
+
+NodeBox nodesIn(const GridGeometry& grid, const WorldRegion& region) {
+  NodeBox box = grid.allNodes();
+  for (int a = 0; a < 3; ++a) {
+    // Node n lies in [lo, hi) when ceil(lo) <= n <= ceil(hi) - 1 in index units.
+    const double lo = std::ceil((region.lo[a] - grid.origin[a]) / grid.spacing[a]);
+    const double hi = std::ceil((region.hi[a] - grid.origin[a]) / grid.spacing[a]) - 1;
+    clipAxis(box, a, lo, hi);
   }
   return box;
 }

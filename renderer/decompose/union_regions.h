@@ -33,4 +33,9 @@ WorldRegion regionOf(const KdTree& tree, int rank);
 // when the volume lies farther away than that.
 NodeBox volumeBoxFor(const GridGeometry& grid, const WorldRegion& region, double step);
 
+// The nodes of `grid` whose positions lie in `region` (half-open, as the
+// ray caster's ownership): the regions of one tree partition each
+// volume's nodes, so counting these counts every node once. May be empty.
+NodeBox nodesIn(const GridGeometry& grid, const WorldRegion& region);
+
 }  // namespace pvr::core

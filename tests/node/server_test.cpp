@@ -1068,6 +1068,11 @@ TEST_CASE_METHOD(Fixture, "several volumes render as one process mixes them, and
     auto status = statusOf(job);
     CHECK_THAT(status["volumes"], Catch::StartsWith("{name phantom source ") && Catch::Contains("visible 1") &&
                                       Catch::Contains("{name field source ") && Catch::Contains("dims {20 20 20}"));
+    // The first volume's histogram counts each of its voxels once, however
+    // the ranks' bricks overlap.
+    double counted = 0;
+    for (double n : numbers(status["histogram"])) counted += n;
+    CHECK(counted == double(kDims[0]) * kDims[1] * kDims[2]);
 
     // Hidden: the phantom alone, through the mixed path's one-volume case.
     job.send(proto::SetScene{"", R"({"volumes": {"field": {"visible": false}}})"});

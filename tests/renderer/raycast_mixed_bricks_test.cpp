@@ -75,7 +75,8 @@ void checkBricks(const std::vector<TestVolume>& volumes, const Camera& camera, c
 }  // namespace
 
 // The union grid covers every domain, at the finest spacing per axis; a
-// region's outer faces are infinite; a volume far from a region has no box.
+// region's outer faces are infinite; a volume far from a region has no box;
+// the regions partition each volume's nodes (nodesIn).
 TEST_CASE("union regions cover every volume and name the nodes each brick reads", "[decompose][mixed]") {
   const GridGeometry a = boxGrid({11, 11, 11}, 1.0, {0, 0, 0}), b = boxGrid({9, 9, 9}, 0.5, {40, 1, 2});
   const GridGeometry u = unionGrid({a, b});
@@ -92,6 +93,22 @@ TEST_CASE("union regions cover every volume and name the nodes each brick reads"
   CHECK(volumeBoxFor(a, right, 0.5).empty());
   CHECK(volumeBoxFor(a, left, 0.5) == a.allNodes());
   CHECK(volumeBoxFor(b, WorldRegion{}, 0.5) == b.allNodes());
+  // Each volume's nodes in the regions: every node once, each inside the
+  // box its brick reads.
+  for (int ranks = 1; ranks <= 9; ++ranks) {
+    const KdTree t = KdTree::build(u, ranks, SplitAxisRule::kLongest);
+    for (const GridGeometry& g : {a, b}) {
+      std::int64_t nodes = 0;
+      for (int r = 0; r < ranks; ++r) {
+        const NodeBox mine = nodesIn(g, regionOf(t, r));
+        if (mine.empty()) continue;
+        nodes += mine.nodeCount();
+        CHECK(volumeBoxFor(g, regionOf(t, r), 0.5).contains(mine));
+        for (int q = 0; q < r; ++q) CHECK(mine.intersect(nodesIn(g, regionOf(t, q))).empty());
+      }
+      CHECK(nodes == g.allNodes().nodeCount());
+    }
+  }
 }
 
 TEST_CASE("bricks of two overlapping volumes of different spacing equal the whole", "[raycast][mixed][bricks]") {
