@@ -280,7 +280,9 @@ Reload openScene(NodeState& state, const std::string& sceneJson) {
   if (!changed && state.valueRange) core::resolveDataDefaults(tf, (*state.valueRange)[0], (*state.valueRange)[1]);
   const bool ghostChanged = ghost != state.ghost;
   state.ghost = ghost;
-  if (changed || (ghostChanged && state.current)) return Reload::kAll;
+  // Every rank decides alike (a rank outside the render clusters holds no
+  // brick, yet takes part in loadBricks' world agreement).
+  if (changed || ghostChanged) return Reload::kAll;
   return stepChanged ? Reload::kStep : Reload::kNone;
 }
 

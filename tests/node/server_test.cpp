@@ -1065,6 +1065,15 @@ TEST_CASE_METHOD(Fixture, "several volumes render as one process mixes them, and
     const SceneReference both(doc);
     checkFrames(job, id, 1, [&](int) { return both.frame(); });
 
+    if (ranks == 4) {
+      // Render ranks beside a compositing cluster: the ranks that hold no
+      // data take part in every volume's agreements.
+      job.send(proto::SetLayout{{{ClusterRole::kRender, 2, 0}, {ClusterRole::kComposite, 2, 0}}});
+      job.expect<proto::SessionReady>();
+      id = job.send(proto::RenderFrame{});
+      checkFrames(job, id, 1, [&](int) { return both.frame(); });
+    }
+
     auto status = statusOf(job);
     CHECK_THAT(status["volumes"], Catch::StartsWith("{name phantom source ") && Catch::Contains("visible 1") &&
                                       Catch::Contains("{name field source ") && Catch::Contains("dims {20 20 20}"));
@@ -1140,5 +1149,25 @@ TEST_CASE_METHOD(Fixture, "a series among several volumes shows each step beside
 
   job.send(proto::SetScene{"", R"({"timestep": 4})"});
   CHECK_THAT(job.expectError().text, Catch::Contains("timestep 4: series.series.json has 4 time steps (0..3)"));
+  CHECK(job.close());
+}
+
+// A setting that changes the ghost layers (shading off: none needed)
+// re-reads the bricks; every rank takes part, those of a compositing
+// cluster too, which hold no brick (they once waited for the others for ever).
+TEST_CASE_METHOD(Fixture, "new ghost layers are read with a compositing cluster beside the render ranks") {
+  Job job(4, {});
+  job.send(proto::SessionOpen{4, {}, ""});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetLayout{{{ClusterRole::kRender, 2, 0}, {ClusterRole::kComposite, 2, 0}}});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  auto id = job.send(proto::RenderFrame{});
+  checkSequence(job, id, 1, 1, Reference(nlohmann::json::object()));
+  job.send(proto::SetScene{"", R"({"shading": {"enabled": false}})"});
+  job.expect<proto::Ok>();
+  id = job.send(proto::RenderFrame{});
+  checkSequence(job, id, 1, 1, Reference(nlohmann::json::parse(R"({"shading": {"enabled": false}})")));
   CHECK(job.close());
 }
