@@ -24,18 +24,28 @@
 
 #include "brick.h"
 #include "raycast/raycaster.h"
+#include "scene_bricks.h"
 
 namespace pvr::node {
 
 // One step's brick for this rank, with its renderer (macrocells built).
 // Held by pointer: the renderer refers to `brick`, so it never moves.
+// A scene of several volumes puts its bricks on screen as `scene`
+// instead (scene_bricks.h; never cached: brick and renderer stay empty).
 struct ReadyBrick {
   int step = 0;
   core::Brick brick;
   std::unique_ptr<core::BrickRenderer> renderer;
+  std::shared_ptr<SceneBricks> scene;
   double readSeconds = 0;        // I/O (brick.loadTimes().read)
   double preprocessSeconds = 0;  // fused preprocessing in the reader plus the renderer's build
-  std::uint64_t bytes() const { return brick.byteSize(); }
+  std::uint64_t bytes() const { return scene ? scene->bytes() : brick.byteSize(); }
+  // This rank's part of the frame (BrickRenderer::render, or the scene's).
+  core::Image render(const core::Camera& camera, const core::RenderOptions& options, core::ThreadPool& pool,
+                     const core::PixelRect* region) const {
+    return scene ? scene->renderer->render(camera, options, pool, nullptr, region)
+                 : renderer->render(camera, options, pool, nullptr, region);
+  }
 };
 
 // Builds the renderer over `brick` (timed) and wraps both.

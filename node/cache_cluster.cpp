@@ -18,7 +18,7 @@ int indexInCluster(const NodeState& state) {
 }  // namespace
 
 bool servedByCacheCluster(const NodeState& state, const ClusterPlan& render) {
-  return render.cacheCluster >= 0 && state.source && state.source->canReadPartially() &&
+  return render.cacheCluster >= 0 && state.source && !state.several() && state.source->canReadPartially() &&
          state.settings.decomposition != Decomposition::kBalanced;
 }
 

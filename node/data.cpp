@@ -10,6 +10,7 @@
 #include "data_summary.h"
 #include "decompose/content.h"
 #include "io/data_directory.h"
+#include "scene_bricks.h"
 #include "scene_volume.h"
 #include "transfer.h"
 
@@ -71,6 +72,30 @@ void distributeStep(NodeState& state, int step) {
   state.pendingDist += secondsSince(start) - (state.pendingRead + state.pendingPreprocess - charged);
 }
 
+// Collective over my render cluster: the union tree and this rank's part
+// of every volume at the step each shows for `step` (scene_bricks.h);
+// nothing is cached or read ahead.
+void distributeSeveral(NodeState& state, int step) {
+  const auto start = Clock::now();
+  const double charged = state.pendingRead + state.pendingPreprocess;
+  dropData(state);
+  comm::SubCommunicator& cluster = *state.clusterComm;
+  std::vector<const core::VolumeSource*> shown;
+  for (const core::VolumeSource* s : state.sources()) shown.push_back(&s->step(stepShown(*s, step)));
+  auto bricks = std::make_shared<SceneBricks>(distributeScene(shown, state.renderOptions.step, cluster));
+  state.tree = bricks->tree;
+  auto ready = std::make_shared<ReadyBrick>();
+  ready->step = step;
+  const auto built = Clock::now();
+  comm::runAgreed(cluster, [&] { bricks->makeRenderer(state.pool.get()); });
+  ready->readSeconds = bricks->loadTimes().read;
+  ready->preprocessSeconds = bricks->loadTimes().preprocess + secondsSince(built);
+  ready->scene = std::move(bricks);
+  putOnScreen(state, std::move(ready), true);
+  state.cache.reset(nullptr);
+  state.pendingDist += secondsSince(start) - (state.pendingRead + state.pendingPreprocess - charged);
+}
+
 // Whether my brick counts towards the histogram: the bricks of one render
 // cluster (the first) cover the volume once; other clusters hold it again.
 bool countsForHistogram(const NodeState& state) {
@@ -84,6 +109,17 @@ bool countsForHistogram(const NodeState& state) {
 // preset to stretch) takes the data's range, and the bricks are classified
 // again, once the range is known.
 void applyDataDefaults(NodeState& state) {
+  if (state.several()) {
+    bool resolved = false;
+    for (std::size_t i = 0; i < state.volumeRanges.size(); ++i) {
+      core::TransferFunctionSpec& tf = state.scene.volumes[i].transfer;
+      if (!state.volumeRanges[i] || !(tf.automatic || tf.rescaleToData)) continue;
+      core::resolveDataDefaults(tf, (*state.volumeRanges[i])[0], (*state.volumeRanges[i])[1]);
+      resolved = true;
+    }
+    if (resolved) classify(state);
+    return;
+  }
   core::TransferFunctionSpec& tf = state.scene.volumes.front().transfer;
   if (!state.valueRange || !(tf.automatic || tf.rescaleToData)) return;
   core::resolveDataDefaults(tf, (*state.valueRange)[0], (*state.valueRange)[1]);
@@ -95,8 +131,19 @@ void applyDataDefaults(NodeState& state) {
 // bricks on screen), then a rank that failed throws; else the data's
 // defaults are applied.
 void agreeOnValueRange(NodeState& state, const std::optional<comm::Failure>& failure) {
-  const core::Brick* brick = state.current ? &state.current->brick : nullptr;
-  const std::optional<DataSummary> summary = summarizeData(state.world, brick, countsForHistogram(state));
+  std::optional<DataSummary> summary;
+  if (state.several()) {
+    // Each volume's range; the first's is the dataset's (status, histogram).
+    const SceneBricks* bricks = state.current ? state.current->scene.get() : nullptr;
+    const auto summaries = summarizeVolumes(state.world, bricks, state.scene.volumes.size(), countsForHistogram(state));
+    state.volumeRanges.assign(summaries.size(), std::nullopt);
+    for (std::size_t i = 0; i < summaries.size(); ++i)
+      if (summaries[i]) state.volumeRanges[i] = summaries[i]->range;
+    summary = summaries.front();
+  } else {
+    const core::Brick* brick = state.current ? &state.current->brick : nullptr;
+    summary = summarizeData(state.world, brick, countsForHistogram(state));
+  }
   state.valueRange.reset();
   state.histogram.clear();
   if (summary) {
@@ -120,17 +167,88 @@ void collectFailure(NodeState& state, const std::function<void()>& phase) {
 // The one rule for a step number (core::checkTimestep), for a step the
 // session shows other than the scene's own (render time).
 void checkStep(const NodeState& state, int step) {
+  if (state.several()) {
+    core::Scene at = state.scene;
+    for (core::SceneVolume& v : at.volumes) v.source.timestep = step;
+    checkSceneTimestep(at, state.sources());
+    return;
+  }
   core::VolumeSpec spec = state.scene.volumes.front().source;
   spec.timestep = step;
   core::checkTimestep(spec, *state.source);
+}
+
+// openScene for a scene of several volumes: each volume opened unless the
+// same one is open at its place in the list; any change of the volumes,
+// the timestep or the step length reads every brick again (margins
+// depend on the step; scene_bricks.h).
+Reload openSeveral(NodeState& state, core::Scene scene) {
+  if (state.settings.decomposition != Decomposition::kKd)
+    throw Error(ErrorCode::kInvalidArgument,
+                "decomposition '" + std::string(decompositionName(state.settings.decomposition)) +
+                    "': a scene of several volumes is split by kd over their union");
+  const std::size_t n = scene.volumes.size();
+  const core::DataDirectory within(state.dataDir);
+  std::vector<std::string> keys(n);
+  std::vector<std::unique_ptr<core::VolumeSource>> opened(n);
+  std::vector<const core::VolumeSource*> sources(n);
+  bool changed = !state.source || !state.sourcesForSceneBricks || state.moreSources.size() + 1 != n;
+  for (std::size_t i = 0; i < n; ++i) {
+    keys[i] = volumeKeyOf(scene.volumes[i].source);
+    const bool same = i == 0 ? state.source && keys[0] == state.volumeKey
+                             : i - 1 < state.moreKeys.size() && state.moreKeys[i - 1] == keys[i];
+    if (same) {
+      sources[i] = i == 0 ? state.source.get() : state.moreSources[i - 1].get();
+      continue;
+    }
+    // Opened at its first step: the scene's timestep is checked over all.
+    core::VolumeSpec first = scene.volumes[i].source;
+    first.timestep = 0;
+    opened[i] = core::openSceneVolume(first, &within);
+    sources[i] = opened[i].get();
+    changed = true;
+  }
+  checkSceneTimestep(scene, sources);
+  std::vector<core::GridGeometry> grids;
+  for (const core::VolumeSource* s : sources) grids.push_back(s->grid());
+  core::resolveDefaults(scene, grids);
+  const core::RenderOptions options = core::renderOptionsFor(scene);
+  // Nothing has changed yet: commit.
+  if (changed) {
+    dropData(state);
+    std::unique_ptr<core::VolumeSource> first = opened[0] ? std::move(opened[0]) : std::move(state.source);
+    std::vector<std::unique_ptr<core::VolumeSource>> more;
+    for (std::size_t i = 1; i < n; ++i)
+      more.push_back(opened[i] ? std::move(opened[i]) : std::move(state.moreSources[i - 1]));
+    state.source = std::move(first);
+    state.moreSources = std::move(more);
+    state.volumeKey = keys[0];
+    state.moreKeys.assign(keys.begin() + 1, keys.end());
+    state.volumeRanges.assign(n, std::nullopt);
+    state.sourcesForSceneBricks = true;
+  }
+  const bool stepChanged = scene.volumes.front().source.timestep != state.scene.volumes.front().source.timestep;
+  const bool lengthChanged = options.step != state.renderOptions.step;
+  state.scene = std::move(scene);
+  state.renderOptions = options;
+  state.ghost = core::ghostLayers(grids.front(), options);
+  // The same volumes: their ranges are known, so are transfer functions
+  // left to them (the caller classifies).
+  for (std::size_t i = 0; i < n && i < state.volumeRanges.size(); ++i)
+    if (state.volumeRanges[i])
+      core::resolveDataDefaults(state.scene.volumes[i].transfer, (*state.volumeRanges[i])[0],
+                                (*state.volumeRanges[i])[1]);
+  return changed || stepChanged || lengthChanged ? Reload::kAll : Reload::kNone;
 }
 
 }  // namespace
 
 Reload openScene(NodeState& state, const std::string& sceneJson) {
   core::Scene scene = core::parseScene(nlohmann::json::parse(sceneJson), state.dataDir);
+  if (needsSceneBricks(scene)) return openSeveral(state, std::move(scene));
   const std::string key = volumeKeyOf(scene.volumes.front().source);
-  const bool changed = key != state.volumeKey || !state.source;
+  // After several volumes, one reads its bricks again even if it was the first.
+  const bool changed = key != state.volumeKey || !state.source || state.sourcesForSceneBricks;
   std::unique_ptr<core::VolumeSource> source;
   const core::VolumeSource* grid = state.source.get();
   if (changed) {
@@ -148,6 +266,10 @@ Reload openScene(NodeState& state, const std::string& sceneJson) {
     dropData(state);
     state.source = std::move(source);
     state.volumeKey = key;
+    state.moreSources.clear();
+    state.moreKeys.clear();
+    state.volumeRanges.clear();
+    state.sourcesForSceneBricks = false;
   }
   const bool stepChanged = scene.volumes.front().source.timestep != state.scene.volumes.front().source.timestep;
   state.scene = scene;
@@ -158,7 +280,9 @@ Reload openScene(NodeState& state, const std::string& sceneJson) {
   if (!changed && state.valueRange) core::resolveDataDefaults(tf, (*state.valueRange)[0], (*state.valueRange)[1]);
   const bool ghostChanged = ghost != state.ghost;
   state.ghost = ghost;
-  if (changed || (ghostChanged && state.current)) return Reload::kAll;
+  // Every rank decides alike (a rank outside the render clusters holds no
+  // brick, yet takes part in loadBricks' world agreement).
+  if (changed || ghostChanged) return Reload::kAll;
   return stepChanged ? Reload::kStep : Reload::kNone;
 }
 
@@ -185,13 +309,19 @@ void loadStep(NodeState& state) {
 void distributeData(NodeState& state) {
   prepareCacheRank(state);
   if (!state.renders() || !state.source) return;
-  distributeStep(state, state.scene.volumes.front().source.timestep);
+  if (state.several()) distributeSeveral(state, state.scene.volumes.front().source.timestep);
+  else distributeStep(state, state.scene.volumes.front().source.timestep);
 }
 
 void showStep(NodeState& state, int step) {
   if (!state.renders() || !state.source) return;
   if (state.current && state.current->step == step) return;
   comm::SubCommunicator& cluster = *state.clusterComm;
+  if (state.several()) {
+    comm::runAgreed(cluster, [&] { checkStep(state, step); });
+    distributeSeveral(state, step);
+    return;
+  }
   if (!state.tree || !state.source->canReadPartially()) {
     comm::runAgreed(cluster, [&] { checkStep(state, step); });
     distributeStep(state, step);  // keeps the decomposition's kind, not its tree
@@ -212,11 +342,14 @@ void showStep(NodeState& state, int step) {
 }
 
 void classify(NodeState& state) {
-  if (state.current) state.current->renderer->classify(state.scene.volumes.front().transfer, state.renderOptions, state.pool.get());
+  if (state.current && state.current->scene)
+    state.current->scene->renderer->classify(state.scene.volumes, state.renderOptions, state.pool.get());
+  else if (state.current) state.current->renderer->classify(state.scene.volumes.front().transfer, state.renderOptions, state.pool.get());
 }
 
 void rebalanceIfNeeded(NodeState& state) {
-  if (!state.renders() || !state.tree || state.settings.decomposition != Decomposition::kBalanced) return;
+  if (!state.renders() || !state.tree || state.settings.decomposition != Decomposition::kBalanced || state.several())
+    return;
   const auto start = Clock::now();
   comm::SubCommunicator& cluster = *state.clusterComm;
 

@@ -26,5 +26,9 @@ struct DataSummary {
 // the agreed range and the bins are summed: the result equals a serial
 // count of the whole volume. Nullopt on every rank when no rank holds a brick.
 std::optional<DataSummary> summarizeData(comm::Communicator& comm, const core::Brick* brick, bool counts);
+// The same with this rank's fine counts given apart from the brick (null:
+// it counts nothing), for bricks whose own counts overlap (scene_bricks.h).
+std::optional<DataSummary> summarizeData(comm::Communicator& comm, const core::Brick* brick,
+                                         const core::FineHistogram* counted);
 
 }  // namespace pvr::node

@@ -16,46 +16,57 @@ using core::KdTree;
 namespace {
 
 constexpr int kBrickTag = 20;
-// Reads or receives this rank's brick of `tree`. With a partial reader each
-// rank reads its own; otherwise `whole` (rank 0's copy of the volume) is cut
-// and sent.
-Brick obtainBrick(const core::VolumeSource& source, const KdTree& tree, int ghostLayers,
-                  const std::optional<Brick>& whole, Communicator& comm) {
+
+}  // namespace
+
+std::optional<Brick> readWholeOnRoot(const core::VolumeSource& source, Communicator& comm) {
+  std::optional<Brick> whole;
+  if (source.canReadPartially()) return whole;
+  runAgreed(comm, [&] {
+    if (comm.rank() == 0) whole = source.readAll();
+  });
+  return whole;
+}
+
+std::optional<Brick> obtainBrick(const core::VolumeSource& source, const std::function<core::NodeBox(int)>& ownedOf,
+                                 int ghostLayers, const std::optional<Brick>& whole, Communicator& comm) {
   const int me = comm.rank();
-  const core::NodeBox owned = tree.ownedBox(me);
-  const core::NodeBox stored = core::storedBox(tree, me, ghostLayers);
+  const core::NodeBox owned = ownedOf(me);
+  const core::NodeBox stored = owned.grown(ghostLayers).intersect(source.grid().allNodes());
+  std::optional<Brick> brick;
   if (source.canReadPartially()) {
-    Brick brick;
-    runAgreed(comm, [&] { brick = source.readBox(owned, stored); });
-    return brick;
-  }
-  // Scatter from rank 0: it sends every other rank its crop, one at a time;
-  // each receiver waits for exactly one message, so nobody can deadlock.
-  Brick brick;
-  if (me == 0) {
-    for (int r = 1; r < comm.size(); ++r) {
-      const Brick crop = core::cropBrick(*whole, tree.ownedBox(r), ghostLayers);
-      comm.send(r, kBrickTag, std::span<const std::byte>(crop.bytes(), crop.byteSize()));
-    }
-    brick = core::cropBrick(*whole, owned, ghostLayers);
-  } else {
-    const comm::Bytes bytes = comm.receive(0, kBrickTag);
     runAgreed(comm, [&] {
-      brick = Brick(source.grid(), source.type(), owned, stored);
-      if (bytes.size() != brick.byteSize())
-        throw Error(ErrorCode::kInternal, "scatter: brick " + core::toString(stored) + " came with " +
-                                              std::to_string(bytes.size()) + " bytes, expected " +
-                                              std::to_string(brick.byteSize()));
-      std::memcpy(brick.bytes(), bytes.data(), bytes.size());
-      brick.updateValueRange();
+      if (!owned.empty()) brick = source.readBox(owned, stored);
     });
     return brick;
   }
-  runAgreed(comm, [] {});  // rank 0's half of the receivers' agreement
+  // Scatter from rank 0: it sends every other rank its crop, one at a time;
+  // each receiver waits for exactly one message, so nobody can deadlock. A
+  // rank owning nothing gets nothing (both sides know).
+  if (me == 0) {
+    for (int r = 1; r < comm.size(); ++r) {
+      const core::NodeBox theirs = ownedOf(r);
+      if (theirs.empty()) continue;
+      const Brick crop = core::cropBrick(*whole, theirs, ghostLayers);
+      comm.send(r, kBrickTag, std::span<const std::byte>(crop.bytes(), crop.byteSize()));
+    }
+    if (!owned.empty()) brick = core::cropBrick(*whole, owned, ghostLayers);
+  } else if (!owned.empty()) {
+    const comm::Bytes bytes = comm.receive(0, kBrickTag);
+    runAgreed(comm, [&] {
+      brick = Brick(source.grid(), source.type(), owned, stored);
+      if (bytes.size() != brick->byteSize())
+        throw Error(ErrorCode::kInternal, "scatter: brick " + core::toString(stored) + " came with " +
+                                              std::to_string(bytes.size()) + " bytes, expected " +
+                                              std::to_string(brick->byteSize()));
+      std::memcpy(brick->bytes(), bytes.data(), bytes.size());
+      brick->updateValueRange();
+    });
+    return brick;
+  }
+  runAgreed(comm, [] {});  // the other half of the receivers' agreement
   return brick;
 }
-
-}  // namespace
 
 const std::vector<DecompositionEntry>& decompositions() {
   static const std::vector<DecompositionEntry> table{{"kd", Decomposition::kKd},
@@ -89,14 +100,10 @@ Distribution distributeBricks(const core::VolumeSource& source, const core::Scen
   runAgreed(comm, [&] { tree = KdTree::build(source.grid(), comm.size(), splitAxisRule(decomposition)); });
 
   // Without a partial reader rank 0 holds the whole volume while it scatters.
-  std::optional<Brick> whole;
-  if (!out.readPartially) {
-    runAgreed(comm, [&] {
-      if (comm.rank() == 0) whole = source.readAll();
-    });
-    if (whole) out.rootReadBytes = whole->byteSize();
-  }
-  out.brick = obtainBrick(source, *tree, ghostLayers, whole, comm);
+  const std::optional<Brick> whole = readWholeOnRoot(source, comm);
+  if (whole) out.rootReadBytes = whole->byteSize();
+  const auto ownedOf = [&](int rank) { return tree->ownedBox(rank); };
+  out.brick = std::move(*obtainBrick(source, ownedOf, ghostLayers, whole, comm));
 
   if (decomposition == Decomposition::kBalanced) {
     // Count what the transfer function shows in my brick; sum over ranks;
@@ -109,7 +116,7 @@ Distribution distributeBricks(const core::VolumeSource& source, const core::Scen
     comm.allReduceSum(content.counts);
     runAgreed(comm, [&] { tree = KdTree::buildBalanced(source.grid(), comm.size(), splitAxisRule(decomposition), content); });
     out.brick = Brick();  // release the first brick before reading the second
-    out.brick = obtainBrick(source, *tree, ghostLayers, whole, comm);
+    out.brick = std::move(*obtainBrick(source, ownedOf, ghostLayers, whole, comm));
   }
   out.tree = std::move(*tree);
   return out;

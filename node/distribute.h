@@ -10,6 +10,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <memory>
 #include <string_view>
 #include <vector>
@@ -53,6 +55,19 @@ struct Distribution {
   bool readPartially = false;    // each rank read its own brick (else rank 0 scattered)
   std::uint64_t rootReadBytes = 0;  // bytes rank 0 held at once while scattering (0 if none)
 };
+
+// Collective: rank 0 reads the whole volume when its format cannot read a
+// box alone (nullopt elsewhere, and everywhere for a partial reader).
+std::optional<core::Brick> readWholeOnRoot(const core::VolumeSource& source, comm::Communicator& comm);
+
+// Collective: this rank's brick of `source` owning ownedOf(comm.rank())
+// plus `ghostLayers` around it (clipped to the grid): read by the rank
+// itself when the format reads a box alone, else cut from `whole` (rank
+// 0's, readWholeOnRoot) and sent. ownedOf(r) is the same on every rank; a
+// rank whose box is empty gets nullopt and nothing is read or sent for it.
+std::optional<core::Brick> obtainBrick(const core::VolumeSource& source,
+                                       const std::function<core::NodeBox(int)>& ownedOf, int ghostLayers,
+                                       const std::optional<core::Brick>& whole, comm::Communicator& comm);
 
 // Collective: every rank calls with the same arguments. `scene` must be
 // resolved (resolveDefaults) for `source`'s grid; it supplies the transfer

@@ -13,6 +13,7 @@
 #include "camera.h"
 #include "data_summary.h"
 #include "raycast/raycaster.h"
+#include "scene_bricks.h"
 #include "scene_volume.h"
 #include "thread_pool.h"
 
@@ -37,6 +38,14 @@ std::vector<RankReport> gatherReports(const RankReport& mine, comm::Communicator
     all.push_back(r);
   }
   return all;
+}
+
+// --early-termination over the scene's sampling.early_termination.
+void overrideEarlyTermination(core::Scene& scene, const FrameOptions& options) {
+  if (!options.earlyTermination) return;
+  if (!(*options.earlyTermination > 0 && *options.earlyTermination <= 1))
+    throw Error(ErrorCode::kInvalidArgument, "early termination must be in (0, 1]");
+  scene.sampling.earlyTermination = *options.earlyTermination;
 }
 
 }  // namespace
@@ -66,8 +75,84 @@ std::uint64_t peakRssBytes() {
   return std::uint64_t(usage.ru_maxrss) * 1024;  // Linux counts kilobytes
 }
 
+namespace {
+
+// prepareFrame for a scene of several volumes (scene_bricks.h): the same
+// phases, every volume opened, read around this rank's region of their
+// union and mixed by one SceneRenderer.
+PreparedFrame prepareSeveral(const core::Scene& sceneIn, const FrameOptions& options, comm::Communicator& comm) {
+  PreparedFrame prepared;
+  FrameResult& result = prepared.frame;
+  RankReport& report = prepared.report;
+  report.start = processAgeSeconds();
+
+  const auto distStart = std::chrono::steady_clock::now();
+  std::vector<std::unique_ptr<core::VolumeSource>> sources;
+  std::vector<const core::VolumeSource*> shown;
+  core::RenderOptions renderOptions;
+  runAgreed(comm, [&] {
+    composite::makeStrategy(options.strategy, options.strategyParams);
+    if (options.decomposition != Decomposition::kKd)
+      throw Error(ErrorCode::kInvalidArgument, "decomposition '" + std::string(decompositionName(options.decomposition)) +
+                                                   "': a scene of several volumes is split by kd over their union");
+    result.scene = sceneIn;
+    std::vector<core::GridGeometry> grids;
+    // Each opened at its first step; the timestep is the scene's (stepShown).
+    const int timestep = sceneIn.volumes.front().source.timestep;
+    std::vector<const core::VolumeSource*> opened;
+    for (const core::SceneVolume& v : sceneIn.volumes) {
+      core::VolumeSpec first = v.source;
+      first.timestep = 0;
+      sources.push_back(options.openVolume ? options.openVolume(first) : core::openSceneVolume(first));
+      opened.push_back(sources.back().get());
+      shown.push_back(&sources.back()->step(stepShown(*sources.back(), timestep)));
+      grids.push_back(sources.back()->grid());
+    }
+    checkSceneTimestep(sceneIn, opened);
+    core::resolveDefaults(result.scene, grids);
+    overrideEarlyTermination(result.scene, options);
+    renderOptions = core::renderOptionsFor(result.scene);
+    for (const auto& source : sources) {
+      result.volume += (result.volume.empty() ? "" : " + ") + source->describe();
+      result.volumeBytes += std::uint64_t(source->grid().allNodes().nodeCount()) * core::scalarSize(source->type());
+    }
+  });
+
+  auto bricks = std::make_shared<SceneBricks>(distributeScene(shown, renderOptions.step, comm));
+  prepared.bricks.tree = bricks->tree;
+  result.readPartially = bricks->readPartially;
+  result.rootReadBytes = bricks->rootReadBytes;
+  report.brickBytes = bricks->bytes();
+  const core::LoadTimes loaded = bricks->loadTimes();
+  report.read = loaded.read;
+  report.dist = std::max(0.0, secondsSince(distStart) - loaded.read - loaded.preprocess);
+
+  // A transfer function left to the data takes its own volume's range.
+  const auto summaries = summarizeVolumes(comm, bricks.get(), result.scene.volumes.size(), false);
+  for (std::size_t i = 0; i < summaries.size(); ++i)
+    if (summaries[i])
+      core::resolveDataDefaults(result.scene.volumes[i].transfer, summaries[i]->range[0], summaries[i]->range[1]);
+
+  runAgreed(comm, [&] {
+    prepared.camera.emplace(result.scene.camera, result.scene.image.width, result.scene.image.height);
+    core::ThreadPool pool(options.threads);
+    const auto prepStart = std::chrono::steady_clock::now();
+    bricks->makeRenderer(&pool);
+    bricks->renderer->classify(result.scene.volumes, renderOptions, &pool);
+    report.prep = loaded.preprocess + secondsSince(prepStart);
+    const auto start = std::chrono::steady_clock::now();
+    prepared.partial = bricks->renderer->render(*prepared.camera, renderOptions, pool);
+    report.rend = secondsSince(start);
+  });
+  prepared.scene = std::move(bricks);
+  return prepared;
+}
+
+}  // namespace
+
 PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& options,
                            comm::Communicator& comm) {
+  if (needsSceneBricks(sceneIn)) return prepareSeveral(sceneIn, options, comm);
   PreparedFrame prepared;
   FrameResult& result = prepared.frame;
   RankReport& report = prepared.report;
@@ -83,11 +168,7 @@ PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& optio
     source = options.openVolume ? options.openVolume(sceneIn.volumes.front().source) : core::openSceneVolume(sceneIn.volumes.front().source);
     result.scene = sceneIn;
     core::resolveDefaults(result.scene, source->grid());
-    if (options.earlyTermination) {
-      if (!(*options.earlyTermination > 0 && *options.earlyTermination <= 1))
-        throw Error(ErrorCode::kInvalidArgument, "early termination must be in (0, 1]");
-      result.scene.sampling.earlyTermination = *options.earlyTermination;
-    }
+    overrideEarlyTermination(result.scene, options);
     renderOptions = core::renderOptionsFor(result.scene);
     result.ghostLayers = core::ghostLayers(source->grid(), renderOptions);
     result.volume = source->describe();

@@ -77,9 +77,11 @@ std::uint64_t peakRssBytes();
 // renderFrame in its two halves, for benchmarks that composite one
 // rendering many ways: prepareFrame opens, distributes and renders (dist,
 // rend); compositeFrame composites with options.strategy and options.codec.
+struct SceneBricks;
 struct PreparedFrame {
   FrameResult frame;      // scene, volume facts; no image or reports yet
-  Distribution bricks;
+  Distribution bricks;    // several volumes: only the tree (their union's)
+  std::shared_ptr<SceneBricks> scene;  // several volumes: this rank's part of each (scene_bricks.h)
   core::Image partial;    // this rank's rendered brick
   std::optional<core::Camera> camera;
   RankReport report;      // start, read, prep, dist, rend, brickBytes

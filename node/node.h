@@ -28,6 +28,7 @@
 #include "pvr_protocol.h"
 #include "raycast/raycaster.h"
 #include "runtime_settings.h"
+#include "scene_bricks.h"
 #include "scene.h"
 #include "strategy.h"
 #include "sub_communicator.h"
@@ -91,6 +92,21 @@ struct NodeState {
   core::RenderOptions renderOptions;
   int ghost = 0;
   std::optional<core::KdTree> tree;  // over my cluster's ranks
+  // A scene of several volumes, or of one hidden (needsSceneBricks,
+  // scene_bricks.h): `source` is the first,
+  // these the others with their keys, in the scene's order; each volume's
+  // value range (the first's is valueRange too). Empty for one volume.
+  std::vector<std::unique_ptr<core::VolumeSource>> moreSources;
+  std::vector<std::string> moreKeys;
+  std::vector<std::optional<std::array<double, 2>>> volumeRanges;
+  bool several() const { return needsSceneBricks(scene); }
+  bool sourcesForSceneBricks = false;  // the sources were opened for the SceneBricks path
+  // Every volume's source, the scene's order.
+  std::vector<const core::VolumeSource*> sources() const {
+    std::vector<const core::VolumeSource*> all{source.get()};
+    for (const auto& s : moreSources) all.push_back(s.get());
+    return all;
+  }
   // The brick of the step on screen (scene.volume.timestep, or the step
   // of the frame a time request renders), ready to render; null without data.
   std::shared_ptr<ReadyBrick> current;

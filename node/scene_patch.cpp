@@ -1,5 +1,6 @@
 #include "scene_patch.h"
 
+#include <algorithm>
 #include <climits>
 #include <cstdlib>
 #include <cstring>
@@ -54,6 +55,100 @@ std::optional<ProtocolError> resolvePresets(nlohmann::json& doc, const std::stri
   return std::nullopt;
 }
 
+// A volume entry of a patch names its data by "dataset" (resolved here to
+// the "file" the ranks open), never by "file". `where` names the entry.
+std::optional<ProtocolError> resolveEntryDataset(nlohmann::json& entry, const std::string& where,
+                                                 const std::string& dataDir) {
+  if (!entry.is_object()) return std::nullopt;  // the scene parser names what is wrong
+  if (entry.contains("file"))
+    return ProtocolError{ErrorCode::kBadArgument, where + ".file: name a dataset, not a volume file"};
+  const auto dataset = entry.find("dataset");
+  if (dataset == entry.end()) return std::nullopt;
+  if (!dataset->is_string())
+    return ProtocolError{ErrorCode::kBadArgument, where + ".dataset: must be a dataset name (a string)"};
+  const std::string name = dataset->get<std::string>();
+  const auto file = resolveDataset(name, dataDir);
+  if (!file)
+    return ProtocolError{ErrorCode::kDatasetNotFound, where + ".dataset: no dataset '" + name + "' in the data directory"};
+  entry.erase("dataset");
+  entry["file"] = *file;
+  return std::nullopt;
+}
+
+// The keys of a volume entry that say where its data comes from.
+constexpr const char* kDataKeys[] = {"file", "procedural", "computation", "dims", "spacing"};
+
+// The session's volumes as a list: a scene in the single form becomes the
+// one-element list named "volume" (docs/protocol.md, SetScene).
+nlohmann::json& volumeList(nlohmann::json& doc) {
+  if (doc.contains("volumes") && doc["volumes"].is_array()) return doc["volumes"];
+  nlohmann::json list = nlohmann::json::array();
+  if (doc.contains("volume") && doc["volume"].is_object()) {
+    nlohmann::json entry = doc["volume"];
+    entry["name"] = "volume";
+    if (doc.contains("transfer_function")) entry["transfer_function"] = doc["transfer_function"];
+    list.push_back(std::move(entry));
+  }
+  doc.erase("volume");
+  doc.erase("transfer_function");
+  doc["volumes"] = std::move(list);
+  return doc["volumes"];
+}
+
+// Applies a patch's "volumes" to doc: an array replaces the list, an
+// object patches volumes by name (docs/protocol.md, SetScene).
+std::optional<ProtocolError> patchVolumes(nlohmann::json& doc, nlohmann::json volumes, const std::string& dataDir) {
+  if (volumes.is_array()) {
+    for (std::size_t i = 0; i < volumes.size(); ++i)
+      if (auto e = resolveEntryDataset(volumes[i], "scene.volumes[" + std::to_string(i) + "]", dataDir)) return e;
+    doc.erase("volume");
+    doc.erase("transfer_function");
+    doc["volumes"] = std::move(volumes);
+    return std::nullopt;
+  }
+  if (!volumes.is_object())
+    return ProtocolError{ErrorCode::kBadArgument,
+                         "scene.volumes: must be a list of volumes or an object {NAME: patch or null}"};
+  nlohmann::json& list = volumeList(doc);
+  for (auto& [name, patch] : volumes.items()) {
+    const std::string where = "scene.volumes." + name;
+    auto at = std::find_if(list.begin(), list.end(), [&](const nlohmann::json& v) {
+      return v.is_object() && v.contains("name") && v["name"] == name;
+    });
+    if (patch.is_null()) {
+      if (at == list.end()) return ProtocolError{ErrorCode::kBadArgument, where + ": no volume '" + name + "' to remove"};
+      if (list.size() == 1)
+        return ProtocolError{ErrorCode::kBadArgument,
+                             where + ": cannot remove the last volume '" + name + "'; name another dataset"};
+      list.erase(at);
+      continue;
+    }
+    if (!patch.is_object())
+      return ProtocolError{ErrorCode::kBadArgument, where + ": must be an object (a volume's keys) or null (remove it)"};
+    if (auto e = resolveEntryDataset(patch, where, dataDir)) return e;
+    bool namesData = false;
+    for (const char* key : {"file", "procedural", "computation"}) namesData |= patch.contains(key);
+    if (at == list.end()) {
+      if (!namesData)
+        return ProtocolError{ErrorCode::kBadArgument,
+                             where + ": a new volume names its data (\"dataset\" or \"procedural\")"};
+      patch["name"] = name;
+      list.push_back(std::move(patch));
+      continue;
+    }
+    // New data replaces the old data's keys; a transfer function is
+    // replaced whole, as a section of its own.
+    if (namesData)
+      for (const char* key : kDataKeys) at->erase(key);
+    if (patch.contains("transfer_function")) {
+      (*at)["transfer_function"] = patch["transfer_function"];
+      patch.erase("transfer_function");
+    }
+    at->merge_patch(patch);
+  }
+  return std::nullopt;
+}
+
 // What the scene parser checks a document against before a volume is named:
 // any valid volume section does, since parsing does not open it.
 nlohmann::json standInVolume() {
@@ -81,6 +176,12 @@ std::variant<SessionScene, ProtocolError> patchScene(const SessionScene& current
         return ProtocolError{ErrorCode::kBadArgument, "scene.volume.file: name a dataset, not a volume file"};
       if (volume->is_null() && current.hasVolume())
         return ProtocolError{ErrorCode::kBadArgument, "scene.volume: cannot be removed; name another dataset"};
+      // "volume": exactly this one volume.
+      if (volume->is_object()) next.doc.erase("volumes");
+    }
+    if (const auto volumes = patch.find("volumes"); volumes != patch.end()) {
+      if (auto refused = patchVolumes(next.doc, *volumes, dataDir)) return *refused;
+      patch.erase("volumes");
     }
     next.doc.merge_patch(patch);
   }
@@ -90,6 +191,7 @@ std::variant<SessionScene, ProtocolError> patchScene(const SessionScene& current
     if (!file)
       return ProtocolError{ErrorCode::kDatasetNotFound, "no dataset '" + request.dataset + "' in the data directory"};
     next.doc["volume"] = {{"file", *file}};
+    next.doc.erase("volumes");  // a dataset is exactly this one volume
   }
 
   // The merged whole, as the ranks will read it.

@@ -26,7 +26,7 @@ struct SessionScene {
   nlohmann::json runtime = nlohmann::json::object();  // the merged "runtime" object
   RuntimeSettings settings;                           // what `runtime` gives
   // A dataset is named (or a procedural volume given): the ranks can load it.
-  bool hasVolume() const { return doc.contains("volume"); }
+  bool hasVolume() const { return doc.contains("volume") || doc.contains("volumes"); }
 };
 
 // `current` with `request` applied and checked, or the error that refuses
@@ -35,7 +35,9 @@ struct SessionScene {
 // refused, so files come only through dataset names; a "paraview_preset"
 // resolves inside dataDir/presets. Every name resolves to a regular file
 // inside its folder after symlinks, or is refused in the same words
-// whether it exists or not.
+// whether it exists or not. "volumes" is patched as docs/protocol.md
+// (SetScene) says: a list replaces the volumes, an object patches them by
+// name; their entries name data by "dataset", resolved likewise.
 std::variant<SessionScene, proto::ProtocolError> patchScene(const SessionScene& current,
                                                             const proto::SetScene& request,
                                                             const std::string& dataDir);

@@ -118,6 +118,7 @@ std::uint64_t oneStepBytes(const NodeState& state) {
 
 // How the render ranks get the steps of a series (brick_cache.h).
 std::string cacheText(const NodeState& state, const RuntimeSettings& settings) {
+  if (state.several()) return "several volumes: each step shown is read again (no read-ahead)";
   const core::VolumeSource& source = *state.source;
   const std::uint64_t budget = cacheBudgetBytes(settings), step = oneStepBytes(state);
   const std::string budgetText = "budget " + std::to_string(settings.cacheMegabytes) + " MB";
@@ -127,6 +128,31 @@ std::string cacheText(const NodeState& state, const RuntimeSettings& settings) {
   const std::uint64_t fits = step > 0 ? budget / step : std::uint64_t(source.steps());
   return "read-ahead: " + budgetText + " holds " + std::to_string(std::min<std::uint64_t>(fits, source.steps())) +
          " of " + std::to_string(source.steps()) + " steps of " + megabytes(step) + " MB per rank";
+}
+
+// Tcl-list quoting of one element (braces; the texts here hold none unbalanced).
+std::string element(const std::string& text) {
+  if (!text.empty() && text.find_first_of(" \t\n{}\"\\$[];") == std::string::npos) return text;
+  return "{" + text + "}";
+}
+
+// Every volume of the scene as a Tcl dict, in the scene's order: what
+// `:s volume list` shows (docs/protocol.md, StatusReply).
+std::string volumesText(const NodeState& state) {
+  const std::vector<const core::VolumeSource*> sources = state.sources();
+  std::string out;
+  for (std::size_t i = 0; i < state.scene.volumes.size() && i < sources.size(); ++i) {
+    const core::SceneVolume& v = state.scene.volumes[i];
+    const core::GridGeometry& grid = sources[i]->grid();
+    std::optional<std::array<double, 2>> range = i == 0 ? state.valueRange : std::nullopt;
+    if (i < state.volumeRanges.size() && state.volumeRanges[i]) range = state.volumeRanges[i];
+    std::string dict = "name " + element(v.name) + " source " + element(sources[i]->describe()) + " dims {" +
+                       list({double(grid.dims.x), double(grid.dims.y), double(grid.dims.z)}) + "} dtype " +
+                       std::string(core::scalarName(sources[i]->type())) + " visible " + (v.visible ? "1" : "0") +
+                       " value_range {" + (range ? list({(*range)[0], (*range)[1]}) : "") + "}";
+    append(out, "{" + dict + "}");
+  }
+  return out;
 }
 
 // The time steps of the dataset and the one shown.
@@ -162,6 +188,7 @@ std::vector<proto::KeyValue> statusEntries(const NodeState& state, const Session
   };
   if (state.source) {
     addDataset(state, out);
+    out.push_back({"volumes", volumesText(state)});
     out.push_back({"camera_automatic", session.cameraSet ? "0" : "1"});
     addTimeSteps(state, settings, out);
   }

@@ -29,7 +29,8 @@ void ReportMemory::run(NodeState& state, const ReportMemory& args) {
   }
   std::uint64_t volumeBytes = 0;
   if (state.source)
-    volumeBytes = std::uint64_t(state.source->grid().allNodes().nodeCount()) * core::scalarSize(state.source->type());
+    for (const core::VolumeSource* source : state.sources())  // every volume of the scene
+      volumeBytes += std::uint64_t(source->grid().allNodes().nodeCount()) * core::scalarSize(source->type());
   state.reply = {{"clusters", clusters}, {"volume_bytes", volumeBytes}, {"ghost_layers", state.ghost}};
 }
 

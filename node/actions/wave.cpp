@@ -59,7 +59,7 @@ void renderMyFrame(NodeState& state, const Wave& args, std::optional<comm::Failu
     core::RenderOptions options = state.renderOptions;
     if (state.watch) options.stop = &state.watch->stop();
     if (state.liveness) options.tilesDone = &state.liveness->progress;
-    w.partial = state.current->renderer->render(camera, options, *state.pool, nullptr, me.bands > 1 ? &band : nullptr);
+    w.partial = state.current->render(camera, options, *state.pool, me.bands > 1 ? &band : nullptr);
     w.rend = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   } catch (...) {
     failure = comm::failureOf(std::current_exception(), state.world.rank());

@@ -31,6 +31,17 @@ void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocel
   p.distance = macrocells.distance();
 }
 
+void ownRegion(KernelParams& p, const GridGeometry& grid, const WorldRegion& region) {
+  for (int a = 0; a < 3; ++a) {
+    const double lo = (region.lo[a] - grid.origin[a]) / grid.spacing[a];
+    const double hi = (region.hi[a] - grid.origin[a]) / grid.spacing[a];
+    const double last = double(grid.dims[a] - 1);
+    p.ownLo[a] = std::max(0.0, lo);
+    p.ownHi[a] = std::min(last, hi);
+    p.hiClosed[a] = hi > last;
+  }
+}
+
 void setOptions(KernelParams& p, const RenderOptions& options, const float* specularTable) {
   p.earlyTermination = float(std::clamp(options.earlyTermination, 0.0, 1.0));
   p.ambient = float(options.shading.ambient);

@@ -8,6 +8,7 @@
 
 #include "../brick.h"
 #include "../camera.h"
+#include "../region.h"
 #include "kernel.h"
 #include "macrocells.h"
 #include "raycaster.h"
@@ -17,6 +18,11 @@ namespace pvr::core {
 // Voxels, strides, owned and stored boxes, cell clamps, spacing and
 // macrocells of `brick`; the classification table is the caller's.
 void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocells);
+
+// Ownership by a region instead of the owned box: the region's faces in
+// index units, clipped to the domain [0, dims - 1], the far face closed
+// where the region reaches beyond the domain (raycaster.h, restrictTo).
+void ownRegion(KernelParams& p, const GridGeometry& grid, const WorldRegion& region);
 
 // Early termination and shading parameters of `options`. `specularTable`
 // (specularTable() of the same shininess) must outlive p.

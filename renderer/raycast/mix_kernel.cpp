@@ -107,33 +107,74 @@ bool runMixedSlots(const MixedVolume* volumes, const RaySetup* rays, const int* 
 // Slot k, [k - 0.5, k + 0.5], in which chords begin or end (at `cuts`,
 // sorted, inside the slot): pieces between the cuts, each mixing the
 // volumes present all along it, each volume by the sample that stands for
-// its part of the slot. Returns true at early termination.
+// its part of the slot; with `own`, only the pieces whose midpoints it
+// owns. Returns true at early termination.
 bool runMixedCutSlot(const MixedVolume* volumes, const RaySetup* rays, const VolumeChord* chords, int n,
-                     std::int64_t k, const double* cuts, int cutCount, float earlyTermination,
-                     kernel::Accumulator& acc, std::uint64_t& samples) {
+                     std::int64_t k, const double* cuts, int cutCount, const MixOwnership* own,
+                     float earlyTermination, kernel::Accumulator& acc, std::uint64_t& samples) {
   const double lo = double(k) - 0.5, hi = double(k) + 0.5;
-  // Each volume met in the slot, classified once.
+  auto present = [&](int i, double from, double to) {
+    return chords[i].hit && chords[i].in <= from && chords[i].out >= to;
+  };
+  // The pieces this brick composites, and the volumes they hold.
+  double from[2 * kMaxMixedVolumes + 1], to[2 * kMaxMixedVolumes + 1];
+  int pieces = 0;
+  bool needed[kMaxMixedVolumes] = {};
+  double start = lo;
+  for (int c = 0; c <= cutCount; ++c) {
+    const double end = c < cutCount ? cuts[c] : hi;
+    if (end > start && (!own || own->owns(0.5 * (start + end)))) {
+      from[pieces] = start;
+      to[pieces] = end;
+      ++pieces;
+      for (int i = 0; i < n; ++i) needed[i] |= present(i, start, end);
+    }
+    start = std::max(start, end);
+  }
+  // Each volume met in them, classified once.
   float value[kMaxMixedVolumes][4] = {};
   for (int i = 0; i < n; ++i) {
-    if (!chords[i].hit || chords[i].in >= hi || chords[i].out <= lo) continue;
+    if (!needed[i] || !volumes[i].sample) continue;
     volumes[i].sample(volumes[i].params, rays[i], chords[i].sampleFor(k), 1, value[i]);
     ++samples;
   }
-  double from = lo;
-  for (int c = 0; c <= cutCount; ++c) {
-    const double to = c < cutCount ? cuts[c] : hi;
-    if (to > from) {
-      float sum[4] = {0, 0, 0, 0};
-      for (int i = 0; i < n; ++i) {
-        if (!chords[i].hit || chords[i].in > from || chords[i].out < to) continue;
-        for (int x = 0; x < 4; ++x) sum[x] += value[i][x];
-      }
-      composite(acc, sum, to - from);
-      if (acc.a >= earlyTermination) return true;
+  for (int c = 0; c < pieces; ++c) {
+    float sum[4] = {0, 0, 0, 0};
+    for (int i = 0; i < n; ++i) {
+      if (!present(i, from[c], to[c])) continue;
+      for (int x = 0; x < 4; ++x) sum[x] += value[i][x];
     }
-    from = std::max(from, to);
+    composite(acc, sum, to[c] - from[c]);
+    if (acc.a >= earlyTermination) return true;
   }
   return false;
+}
+
+// The slots [first, last] where a ray may have pieces `own` owns, and the
+// samples [ownFirst, ownLast] it owns (contiguous: the region is convex).
+// False if the ray misses the region. The slab estimate is within a sample
+// or two; the exact test decides, as sampleRange (kernel.h) does.
+bool ownedSpan(const MixOwnership& own, std::int64_t& first, std::int64_t& last, std::int64_t& ownFirst,
+               std::int64_t& ownLast) {
+  double tIn = double(first) - 1, tOut = double(last) + 1;
+  for (int a = 0; a < 3; ++a) {
+    if (own.step[a] == 0) {
+      if (!(own.origin[a] >= own.lo[a] && own.origin[a] < own.hi[a])) return false;
+      continue;
+    }
+    double t0 = (own.lo[a] - own.origin[a]) / own.step[a], t1 = (own.hi[a] - own.origin[a]) / own.step[a];
+    if (t0 > t1) std::swap(t0, t1);
+    tIn = std::max(tIn, t0);
+    tOut = std::min(tOut, t1);
+  }
+  if (tIn > tOut + 2) return false;
+  first = std::max(first, std::int64_t(std::floor(tIn)) - 2);
+  last = std::min(last, std::int64_t(std::ceil(tOut)) + 2);
+  ownFirst = first;
+  ownLast = last;
+  while (ownFirst <= ownLast && !own.owns(double(ownFirst))) ++ownFirst;
+  while (ownLast >= ownFirst && !own.owns(double(ownLast))) --ownLast;
+  return first <= last;
 }
 
 }  // namespace
@@ -146,7 +187,7 @@ MixSampler pickMixSampler(ScalarType type, bool shaded) {
 }
 
 RayResult castMixedRay(const MixedVolume* volumes, const RaySetup* rays, int n, float earlyTermination,
-                       int mcShift) {
+                       int mcShift, const MixOwnership* own) {
   RayResult out;
   // Each volume's chord, and the cuts where the set of volumes changes.
   VolumeChord chords[kMaxMixedVolumes];
@@ -162,15 +203,19 @@ RayResult castMixedRay(const MixedVolume* volumes, const RaySetup* rays, int n, 
     cuts[cutCount++] = c.out;
   }
   if (cutCount == 0) return out;
-  out.hit = true;
   std::sort(cuts, cuts + cutCount);
 
   // Sample k stands for its slot [k - 0.5, k + 0.5] of the ray. Runs of
   // slots without a cut have one set of volumes, each sampled at k; a slot
   // with cuts is split at them (runMixedCutSlot).
+  // With `own`, only the slots where this brick's region may own pieces,
+  // and of runs without cuts only the samples it owns.
   kernel::Accumulator acc;
   std::int64_t k = std::int64_t(std::floor(cuts[0] + 0.5));
-  const std::int64_t lastSlot = std::int64_t(std::floor(cuts[cutCount - 1] + 0.5));
+  std::int64_t lastSlot = std::int64_t(std::floor(cuts[cutCount - 1] + 0.5));
+  std::int64_t ownFirst = k, ownLast = lastSlot;
+  if (own && !ownedSpan(*own, k, lastSlot, ownFirst, ownLast)) return out;
+  out.hit = true;
   int next = 0;  // the first cut beyond slot k's start
   while (k <= lastSlot) {
     const double lo = double(k) - 0.5, hi = double(k) + 0.5;
@@ -178,7 +223,8 @@ RayResult castMixedRay(const MixedVolume* volumes, const RaySetup* rays, int n, 
     if (next < cutCount && cuts[next] < hi) {
       int inSlot = 0;
       while (next + inSlot < cutCount && cuts[next + inSlot] < hi) ++inSlot;
-      if (runMixedCutSlot(volumes, rays, chords, n, k, cuts + next, inSlot, earlyTermination, acc, out.samples))
+      if (runMixedCutSlot(volumes, rays, chords, n, k, cuts + next, inSlot, own, earlyTermination, acc,
+                          out.samples))
         break;
       ++k;
       continue;
@@ -188,9 +234,10 @@ RayResult castMixedRay(const MixedVolume* volumes, const RaySetup* rays, int n, 
         next < cutCount ? std::int64_t(std::floor(cuts[next] - 0.5)) : lastSlot;
     int active[kMaxMixedVolumes], m = 0;
     for (int i = 0; i < n; ++i)
-      if (chords[i].hit && chords[i].in <= lo && chords[i].out >= hi) active[m++] = i;
-    if (m > 0 &&
-        runMixedSlots(volumes, rays, active, m, k, end, earlyTermination, mcShift, acc, out.samples))
+      if (chords[i].hit && volumes[i].sample && chords[i].in <= lo && chords[i].out >= hi) active[m++] = i;
+    const std::int64_t runFirst = std::max(k, ownFirst), runLast = std::min(end, ownLast);
+    if (m > 0 && runFirst <= runLast &&
+        runMixedSlots(volumes, rays, active, m, runFirst, runLast, earlyTermination, mcShift, acc, out.samples))
       break;
     k = std::max(k + 1, end + 1);
   }

@@ -52,9 +52,30 @@ struct MixedVolume {
   MixSampler sample = nullptr;
 };
 
+// Which parts of a ray a brick of a decomposed scene composites (region.h):
+// sample k lies at world position origin + k * step, and a piece of the
+// ray belongs to the region that holds its midpoint (a slot without cuts:
+// its sample). A volume's sample standing for an owned piece lies within
+// a step of the region, which volumeBoxFor() stores.
+struct MixOwnership {
+  double origin[3], step[3];
+  double lo[3], hi[3];  // the region, half-open; infinite faces bound nothing
+
+  bool owns(double k) const {
+    for (int a = 0; a < 3; ++a) {
+      const double x = origin[a] + k * step[a];
+      if (!(x >= lo[a] && x < hi[a])) return false;
+    }
+    return true;
+  }
+};
+
 // `rays[i]` is the camera ray in volume i's index space (raySetup), n <=
-// kMaxMixedVolumes. Every volume must be a whole volume with cells on every axis.
+// kMaxMixedVolumes; every volume has cells on every axis. With `own` null
+// the whole ray is composited and every volume is whole; otherwise only
+// the pieces `own` owns, and a volume whose sampler is null (no data near
+// the region) only cuts the ray.
 RayResult castMixedRay(const MixedVolume* volumes, const RaySetup* rays, int n, float earlyTermination,
-                       int mcShift);
+                       int mcShift, const MixOwnership* own = nullptr);
 
 }  // namespace pvr::core

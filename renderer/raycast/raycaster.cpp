@@ -68,11 +68,18 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   const GridGeometry& grid = brick_.grid();
   const NodeBox& own = brick_.owned();
 
-  // Screen rectangle of the owned box; a grid one node thick has no cells
-  // and shows nothing.
-  const Vec3 lo = grid.nodePosition(own.lo), hi = grid.nodePosition(own.hi);
+  // Screen rectangle of the owned box (or the region's part of the
+  // domain); a grid one node thick has no cells and shows nothing.
+  Vec3 lo = grid.nodePosition(own.lo), hi = grid.nodePosition(own.hi);
   bool degenerate = false;
   for (int a = 0; a < 3; ++a) degenerate |= grid.dims[a] < 2;
+  if (region_) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(grid.domainMin()[a], region_->lo[a]);
+      hi[a] = std::min(grid.domainMax()[a], region_->hi[a]);
+      degenerate |= lo[a] > hi[a];
+    }
+  }
   PixelRect rect = degenerate ? PixelRect{} : camera.project(lo, hi);
   if (region) rect = rect.intersect(*region);
   Image image(camera.width(), camera.height(), rect);
@@ -84,6 +91,7 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   // Set up what does not change per ray.
   KernelParams p;
   setBrick(p, brick_, macrocells_);
+  if (region_) ownRegion(p, grid, *region_);
   if (preintegrated_) {
     p.table = preintegrated_->entries();
     p.tableEntries = PreintegratedTable::kEntries;

@@ -13,10 +13,12 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "../brick.h"
 #include "../camera.h"
 #include "../image.h"
+#include "../region.h"
 #include "../scene.h"
 #include "../thread_pool.h"
 #include "../transfer.h"
@@ -71,6 +73,14 @@ class BrickRenderer {
   Image render(const Camera& camera, const RenderOptions& options, ThreadPool& pool,
                RenderStats* stats = nullptr, const PixelRect* region = nullptr) const;
 
+  // Renders only the samples whose position lies in `region` instead of
+  // those of the brick's owned box: the brick is this volume's part of a
+  // rank's region of a several-volume scene (decompose/union_regions.h)
+  // and stores at least volumeBoxFor(grid, region, step). Membership is
+  // tested in the volume's index space against the region's faces, the
+  // same numbers in every brick, so the regions still partition the samples.
+  void restrictTo(const WorldRegion& region) { region_ = region; }
+
   const Brick& brick() const { return brick_; }
   const MacrocellGrid& macrocells() const { return macrocells_; }
   // Seconds the constructor spent computing macrocell bounds: 0 when the
@@ -83,6 +93,7 @@ class BrickRenderer {
   TransferTable table_;
   std::unique_ptr<PreintegratedTable> preintegrated_;
   double classifiedStep_ = 0;
+  std::optional<WorldRegion> region_;
 };
 
 }  // namespace pvr::core

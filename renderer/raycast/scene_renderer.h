@@ -9,7 +9,8 @@
 //
 // Pre-integration applies to one visible volume; several are point-sampled
 // (each segment's samples mix plain extinction tables), whatever
-// options.preintegrated says.
+// options.preintegrated says. A brick of a decomposed scene takes the
+// same path for the same visible volumes as the whole does.
 #pragma once
 
 #include <memory>
@@ -18,6 +19,7 @@
 #include "../brick.h"
 #include "../camera.h"
 #include "../image.h"
+#include "../region.h"
 #include "../scene.h"
 #include "../thread_pool.h"
 #include "../transfer.h"
@@ -31,6 +33,17 @@ class SceneRenderer {
   // whole grid); each must outlive the renderer. Builds each one's
   // macrocells, over the pool when given.
   explicit SceneRenderer(const std::vector<const Brick*>& volumes, ThreadPool* pool = nullptr);
+
+  // One brick of a scene decomposed over its volumes' union
+  // (decompose/union_regions.h): renders only the parts of rays whose
+  // midpoints lie in `region`, so the bricks of a decomposition rendered
+  // apart and composited in visibility order equal the whole. grids[i] is
+  // volume i's grid; bricks[i] holds at least volumeBoxFor(grids[i],
+  // region, step) of it for every step it is classified with, or is null
+  // where that box is empty (the volume is far from the region, and only
+  // its domain's faces matter here).
+  SceneRenderer(const std::vector<const Brick*>& bricks, const std::vector<GridGeometry>& grids,
+                const WorldRegion& region, ThreadPool* pool = nullptr);
 
   // Classifies each volume by the scene's entry of the same index (its
   // transfer function, resolved, and visibility); `volumes` has one entry
@@ -54,11 +67,13 @@ class SceneRenderer {
                     RenderStats* stats, const PixelRect* region) const;
 
   struct Layer {
-    const Brick* brick = nullptr;
+    GridGeometry grid;
+    const Brick* brick = nullptr;  // null: no data near the region
     std::unique_ptr<BrickRenderer> renderer;  // macrocells, and the one-volume path
     ExtinctionTable extinction;               // the mixed path's table
   };
   std::vector<Layer> layers_;
+  WorldRegion region_;
   std::vector<int> shown_;
   double classifiedStep_ = 0;
   bool classifiedPreintegrated_ = false;

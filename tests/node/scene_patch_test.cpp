@@ -146,3 +146,80 @@ TEST_CASE("a scene patch nested deeper than the protocol's JSON limit is refused
   CHECK(e.code == proto::ErrorCode::kMalformedPayload);
   CHECK(e.text == "scene: JSON nests deeper than 64 levels (at byte 320)");
 }
+
+// docs/protocol.md, SetScene: "volumes" as a list replaces the volumes and
+// drops the single form; entries name data by "dataset", resolved in the
+// data directory; "file" and unknown datasets are refused naming the entry.
+TEST_CASE("a volumes list replaces the session's volumes, its datasets resolved in the data directory") {
+  const SessionScene one = accepted({}, {"ct.json", R"({"transfer_function": {"points": [[0, 1, 1, 1, 0], [1, 1, 1, 1, 1]]}})"});
+  const SessionScene two = accepted(one, {"", R"({"volumes": [
+      {"name": "ct", "dataset": "ct.json", "visible": false},
+      {"name": "ml", "procedural": "marschner-lobb", "dims": [9, 9, 9]}]})"});
+  CHECK_FALSE(two.doc.contains("volume"));
+  CHECK_FALSE(two.doc.contains("transfer_function"));
+  REQUIRE(two.doc["volumes"].size() == 2);
+  CHECK(two.doc["volumes"][0]["file"] == dataDir() + "/ct.json");
+  CHECK_FALSE(two.doc["volumes"][0].contains("dataset"));
+  CHECK(two.doc["volumes"][0]["visible"] == false);
+  CHECK(two.doc["volumes"][1]["procedural"] == "marschner-lobb");
+
+  auto e = refused(one, {"", R"({"volumes": [{"name": "a", "file": "/etc/passwd"}]})"});
+  CHECK(e.code == proto::ErrorCode::kBadArgument);
+  CHECK(e.text == "scene.volumes[0].file: name a dataset, not a volume file");
+  e = refused(one, {"", R"({"volumes": [{"name": "a", "dataset": "ct.json"}, {"name": "b", "dataset": "passwd.json"}]})"});
+  CHECK(e.code == proto::ErrorCode::kDatasetNotFound);
+  CHECK(e.text == "scene.volumes[1].dataset: no dataset 'passwd.json' in the data directory");
+  // Names are unique: the scene parser's check, naming the entry.
+  e = refused(one, {"", R"({"volumes": [{"name": "a", "dataset": "ct.json"}, {"name": "a", "dataset": "ct.json"}]})"});
+  CHECK(e.text.find("volumes[1].name") != std::string::npos);
+}
+
+// docs/protocol.md, SetScene: "volumes" as an object patches volumes by
+// name: add (naming data), change visible or the transfer function,
+// remove with null, never the last; a single-form scene is first the list
+// [volume]; a dataset is exactly one volume again.
+TEST_CASE("volumes patched by name are added, changed and removed, and a dataset means one volume") {
+  const SessionScene one = accepted({}, {"ct.json", R"({"transfer_function": {"points": [[0, 1, 1, 1, 0], [1, 1, 1, 1, 1]]}})"});
+  const SessionScene two = accepted(one, {"", R"({"volumes": {"pet": {"dataset": "ct.json", "visible": false}}})"});
+  REQUIRE(two.doc["volumes"].size() == 2);
+  CHECK(two.doc["volumes"][0]["name"] == "volume");
+  CHECK(two.doc["volumes"][0]["file"] == dataDir() + "/ct.json");
+  CHECK(two.doc["volumes"][0]["transfer_function"]["points"][1][4] == 1);
+  CHECK(two.doc["volumes"][1]["name"] == "pet");
+  CHECK_FALSE(two.doc.contains("volume"));
+
+  // Another transfer function replaces the old whole; visibility merges.
+  const SessionScene changed = accepted(two, {"", R"({"volumes": {"pet": {"visible": true,
+      "transfer_function": {"paraview_preset": "bone.json"}}}})"});
+  const auto& pet = changed.doc["volumes"][1];
+  CHECK(pet["visible"] == true);
+  CHECK(pet["transfer_function"] == nlohmann::json{{"paraview_preset", dataDir() + "/presets/bone.json"}});
+  // New data replaces the old data's keys.
+  const SessionScene procedural =
+      accepted(changed, {"", R"({"volumes": {"pet": {"procedural": "shepp-logan", "dims": [8, 8, 8]}}})"});
+  CHECK_FALSE(procedural.doc["volumes"][1].contains("file"));
+  CHECK(procedural.doc["volumes"][1]["procedural"] == "shepp-logan");
+
+  const SessionScene removed = accepted(changed, {"", R"({"volumes": {"volume": null}})"});
+  REQUIRE(removed.doc["volumes"].size() == 1);
+  CHECK(removed.doc["volumes"][0]["name"] == "pet");
+  auto e = refused(removed, {"", R"({"volumes": {"pet": null}})"});
+  CHECK(e.text == "scene.volumes.pet: cannot remove the last volume 'pet'; name another dataset");
+  e = refused(removed, {"", R"({"volumes": {"nope": null}})"});
+  CHECK(e.text == "scene.volumes.nope: no volume 'nope' to remove");
+  e = refused(removed, {"", R"({"volumes": {"new": {"visible": true}}})"});
+  CHECK(e.text == "scene.volumes.new: a new volume names its data (\"dataset\" or \"procedural\")");
+  e = refused(removed, {"", R"({"volumes": {"pet": {"dataset": "missing.json"}}})"});
+  CHECK(e.code == proto::ErrorCode::kDatasetNotFound);
+  e = refused(removed, {"", R"({"volumes": 3})"});
+  CHECK(e.code == proto::ErrorCode::kBadArgument);
+
+  // set -dataset: exactly this one volume.
+  const SessionScene single = accepted(changed, {"ct.json", ""});
+  CHECK_FALSE(single.doc.contains("volumes"));
+  CHECK(single.doc["volume"]["file"] == dataDir() + "/ct.json");
+  // So does a "volume" of the scene document.
+  const SessionScene generated =
+      accepted(changed, {"", R"({"volume": {"procedural": "shepp-logan", "dims": [8, 8, 8]}})"});
+  CHECK_FALSE(generated.doc.contains("volumes"));
+}

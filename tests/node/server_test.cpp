@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <list>
 #include <map>
 #include <sstream>
 #include <nlohmann/json.hpp>
@@ -34,6 +35,8 @@
 #include "io/volume_io.h"
 #include "pvr_protocol.h"
 #include "raycast/raycaster.h"
+#include "raycast/scene_renderer.h"
+#include "scene_volume.h"
 #include "scene.h"
 #include "secure_channel.h"
 #include "strategy.h"
@@ -337,6 +340,44 @@ class Reference {
   std::unique_ptr<core::VolumeSource> source_;
   core::Brick brick_;
   std::unique_ptr<core::BrickRenderer> renderer_;
+  core::RenderOptions options_;
+  mutable core::ThreadPool pool_{1};
+};
+
+// The reference for a scene of several volumes: the whole volumes mixed
+// in one SceneRenderer (a scene of one goes through its BrickRenderer
+// there, as the ranks' one-volume path does). `doc` names data files by
+// "dataset" as a client does; they are the data directory's.
+class SceneReference {
+ public:
+  explicit SceneReference(nlohmann::json doc) {
+    for (auto& v : doc["volumes"])
+      if (v.contains("dataset")) {
+        v["file"] = (kTmp / "data" / v["dataset"].get<std::string>()).string();
+        v.erase("dataset");
+      }
+    scene_ = core::parseScene(doc, "");
+    std::vector<core::GridGeometry> grids;
+    for (const core::SceneVolume& v : scene_.volumes) {
+      bricks_.push_back(core::openSceneVolume(v.source)->readAll());
+      grids.push_back(bricks_.back().grid());
+    }
+    core::resolveDefaults(scene_, grids);
+    std::vector<const core::Brick*> whole;
+    for (const core::Brick& b : bricks_) whole.push_back(&b);
+    renderer_ = std::make_unique<core::SceneRenderer>(whole);
+    options_ = core::renderOptionsFor(scene_);
+    renderer_->classify(scene_.volumes, options_);
+  }
+  core::Image frame() const {
+    const core::Camera camera(scene_.camera, scene_.image.width, scene_.image.height);
+    return renderer_->render(camera, options_, pool_).toFullFrame();
+  }
+
+ private:
+  core::Scene scene_;
+  std::list<core::Brick> bricks_;
+  std::unique_ptr<core::SceneRenderer> renderer_;
   core::RenderOptions options_;
   mutable core::ThreadPool pool_{1};
 };
@@ -994,5 +1035,139 @@ TEST_CASE_METHOD(Fixture, "the master sends Heartbeat frames to the handler, req
     CHECK(d->info.final());
     ++heartbeats;
   }
+  CHECK(job.close());
+}
+
+// Several volumes through SetScene (docs/protocol.md): the data file of
+// the phantom and a procedural Marschner-Lobb box of another spacing that
+// overlaps one corner of it. Each frame equals the whole scene mixed in
+// one process within 1e-5 (the rendering contract's tolerance for bricks,
+// tests/renderer/raycast_mixed_bricks_test.cpp), on 1, 3 and 4 ranks; a
+// volume hidden, then removed, by name, then the last one hidden and
+// shown again; status lists the volumes.
+TEST_CASE_METHOD(Fixture, "several volumes render as one process mixes them, and patches by name hide and remove them", "[volumes]") {
+  nlohmann::json doc = nlohmann::json::parse(R"({
+    "volumes": [
+      {"name": "phantom", "dataset": "phantom.json",
+       "transfer_function": {"points": [[0, 0, 0, 0, 0], [0.15, 0.3, 0.5, 1, 0.05], [0.3, 1, 0.8, 0.3, 0.3], [1, 1, 1, 1, 0.6]]}},
+      {"name": "field", "procedural": "marschner-lobb", "dims": [20, 20, 20], "spacing": [1.5, 1.5, 1.5],
+       "transfer_function": {"points": [[0, 0.1, 0.3, 0.9, 0], [0.55, 0.1, 0.3, 0.9, 0], [0.7, 0.3, 0.6, 1, 0.05], [1, 0.8, 0.9, 1, 0.2]]}}],
+    "image": {"width": 64, "height": 64, "background": [0, 0, 0, 1]},
+    "shading": {"enabled": true}})");
+  for (int ranks : {1, 3, 4}) {
+    INFO(ranks << " ranks");
+    Job job(ranks, {});
+    job.send(proto::SessionOpen{std::uint32_t(ranks), {}, ""});
+    job.expect<proto::SessionReady>();
+    job.send(proto::SetScene{"", doc.dump()});
+    job.expect<proto::Ok>();
+    auto id = job.send(proto::RenderFrame{});
+    const SceneReference both(doc);
+    checkFrames(job, id, 1, [&](int) { return both.frame(); });
+
+    if (ranks == 4) {
+      // Render ranks beside a compositing cluster: the ranks that hold no
+      // data take part in every volume's agreements.
+      job.send(proto::SetLayout{{{ClusterRole::kRender, 2, 0}, {ClusterRole::kComposite, 2, 0}}});
+      job.expect<proto::SessionReady>();
+      id = job.send(proto::RenderFrame{});
+      checkFrames(job, id, 1, [&](int) { return both.frame(); });
+    }
+
+    auto status = statusOf(job);
+    CHECK_THAT(status["volumes"], Catch::StartsWith("{name phantom source ") && Catch::Contains("visible 1") &&
+                                      Catch::Contains("{name field source ") && Catch::Contains("dims {20 20 20}"));
+    // The first volume's histogram counts each of its voxels once, however
+    // the ranks' bricks overlap.
+    double counted = 0;
+    for (double n : numbers(status["histogram"])) counted += n;
+    CHECK(counted == double(kDims[0]) * kDims[1] * kDims[2]);
+
+    // Hidden: the phantom alone, through the mixed path's one-volume case.
+    job.send(proto::SetScene{"", R"({"volumes": {"field": {"visible": false}}})"});
+    job.expect<proto::Ok>();
+    id = job.send(proto::RenderFrame{});
+    nlohmann::json hidden = doc;
+    hidden["volumes"][1]["visible"] = false;
+    const SceneReference phantom(hidden);
+    checkFrames(job, id, 1, [&](int) { return phantom.frame(); });
+    // Each volume shows in the frames: hiding one changes the image.
+    CHECK(core::maxAbsDifference(both.frame(), phantom.frame()) > 0.05);
+    CHECK(core::maxAbsDifference(phantom.frame(), core::Image::fullFrame(64, 64)) > 0.2);
+    CHECK_THAT(statusOf(job)["volumes"], Catch::Contains("visible 0"));
+
+    // Removed: a scene of one volume again, on the one-volume path.
+    job.send(proto::SetScene{"", R"({"volumes": {"field": null}})"});
+    job.expect<proto::Ok>();
+    id = job.send(proto::RenderFrame{});
+    nlohmann::json alone = doc;
+    alone["volumes"].erase(1);
+    const SceneReference one(alone);
+    checkFrames(job, id, 1, [&](int) { return one.frame(); });
+
+    // The last volume hidden shows nothing; shown again, it is back.
+    job.send(proto::SetScene{"", R"({"volumes": {"phantom": {"visible": false}}})"});
+    job.expect<proto::Ok>();
+    id = job.send(proto::RenderFrame{});
+    checkFrames(job, id, 1, [&](int) { return core::Image::fullFrame(64, 64); });
+    job.send(proto::SetScene{"", R"({"volumes": {"phantom": {"visible": true}}})"});
+    job.expect<proto::Ok>();
+    id = job.send(proto::RenderFrame{});
+    checkFrames(job, id, 1, [&](int) { return one.frame(); });
+    CHECK(job.close());
+  }
+}
+
+// A time series among several volumes (docs/scene.md, "Several volumes"):
+// the series shows the scene's timestep and each frame of a time request
+// its own step, the single volume beside it every time; a timestep past
+// the longest series is refused with checkTimestep's words.
+TEST_CASE_METHOD(Fixture, "a series among several volumes shows each step beside the other volume", "[volumes][series]") {
+  const auto docAt = [](const std::string& run) {
+    return nlohmann::json{
+        {"volumes",
+         {{{"name", "run"}, {"dataset", run},
+           {"transfer_function", {{"points", {{0, 0, 0, 0, 0}, {0.15, 0.3, 0.5, 1, 0.05}, {0.3, 1, 0.8, 0.3, 0.3}, {1, 1, 1, 1, 0.6}}}}}},
+          {{"name", "field"}, {"procedural", "marschner-lobb"}, {"dims", {20, 20, 20}}, {"spacing", {1.5, 1.5, 1.5}},
+           {"transfer_function", {{"points", {{0, 0.1, 0.3, 0.9, 0}, {0.55, 0.1, 0.3, 0.9, 0}, {0.7, 0.3, 0.6, 1, 0.05}, {1, 0.8, 0.9, 1, 0.2}}}}}}}},
+        {"image", {{"width", 48}, {"height", 48}}},
+        {"shading", {{"enabled", true}}}};
+  };
+  Job job(3, {});
+  job.send(proto::SessionOpen{3, {}, ""});
+  job.expect<proto::SessionReady>();
+  nlohmann::json doc = docAt(kSeries);
+  doc["timestep"] = 2;
+  job.send(proto::SetScene{"", doc.dump()});
+  job.expect<proto::Ok>();
+  auto id = job.send(proto::RenderFrame{});
+  const SceneReference step2(docAt(stepFile(2)));
+  checkFrames(job, id, 1, [&](int) { return step2.frame(); });
+
+  id = job.send(proto::RenderTimeSteps{0, 3, 1});
+  checkFrames(job, id, 4, [&](int k) { return SceneReference(docAt(stepFile(k))).frame(); });
+
+  job.send(proto::SetScene{"", R"({"timestep": 4})"});
+  CHECK_THAT(job.expectError().text, Catch::Contains("timestep 4: series.series.json has 4 time steps (0..3)"));
+  CHECK(job.close());
+}
+
+// A setting that changes the ghost layers (shading off: none needed)
+// re-reads the bricks; every rank takes part, those of a compositing
+// cluster too, which hold no brick (they once waited for the others for ever).
+TEST_CASE_METHOD(Fixture, "new ghost layers are read with a compositing cluster beside the render ranks") {
+  Job job(4, {});
+  job.send(proto::SessionOpen{4, {}, ""});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetLayout{{{ClusterRole::kRender, 2, 0}, {ClusterRole::kComposite, 2, 0}}});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  auto id = job.send(proto::RenderFrame{});
+  checkSequence(job, id, 1, 1, Reference(nlohmann::json::object()));
+  job.send(proto::SetScene{"", R"({"shading": {"enabled": false}})"});
+  job.expect<proto::Ok>();
+  id = job.send(proto::RenderFrame{});
+  checkSequence(job, id, 1, 1, Reference(nlohmann::json::parse(R"({"shading": {"enabled": false}})")));
   CHECK(job.close());
 }

@@ -20,84 +20,14 @@
 
 #include "raycast/raycaster.h"
 #include "raycast/scene_renderer.h"
+#include "mixed_scenes.h"
 #include "reference.h"
 
 namespace pvr::core {
 namespace {
 
-ThreadPool& pool() {
-  static ThreadPool p(2);
-  return p;
-}
+using namespace test;
 
-double maxAlpha(const Image& image) {
-  double a = 0;
-  for (const Rgba& p : image.pixels()) a = std::max(a, double(p.a));
-  return a;
-}
-
-// A volume of the scene: grid, voxels and transfer function.
-struct TestVolume {
-  Brick brick;
-  TransferFunctionSpec tf;
-  bool visible = true;
-};
-
-GridGeometry boxGrid(IVec3 dims, double spacing, Vec3 origin) {
-  GridGeometry g;
-  g.dims = dims;
-  g.spacing = {spacing, spacing, spacing};
-  g.origin = origin;
-  return g;
-}
-
-// A smooth field over the grid's box (normalised coordinates): one broad
-// Gaussian off-centre plus a gentle wave; values in [0, 1].
-Brick smoothVolume(const GridGeometry& grid, Vec3 centre, ScalarType type = ScalarType::kFloat32) {
-  const Vec3 lo = grid.domainMin(), hi = grid.domainMax();
-  return makeVolume(grid, type, [=](Vec3 p) {
-    Vec3 q;
-    for (int a = 0; a < 3; ++a) q[a] = (p[a] - lo[a]) / (hi[a] - lo[a]);
-    const Vec3 d = q - centre;
-    const double v = 0.75 * std::exp(-dot(d, d) / 0.08) + 0.15 * (1 + std::sin(5 * q.x + 3 * q.y - 2 * q.z));
-    const double scaled = std::min(1.0, v);
-    return type == ScalarType::kUInt8 ? 255 * scaled : scaled;
-  });
-}
-
-TransferFunctionSpec tfOf(std::vector<TransferPoint> points, double unitDistance) {
-  TransferFunctionSpec tf;
-  tf.points = std::move(points);
-  tf.unitDistance = unitDistance;
-  return tf;
-}
-
-// Warm and cool media, opacities up to 0.3 per unit distance.
-TransferFunctionSpec warm(double unit) {
-  return tfOf({{0.0, 0.2, 0.0, 0.0, 0.0}, {0.3, 0.9, 0.4, 0.1, 0.05}, {1.0, 1.0, 0.9, 0.6, 0.3}}, unit);
-}
-TransferFunctionSpec cool(double unit) {
-  return tfOf({{0.0, 0.0, 0.1, 0.3, 0.0}, {0.4, 0.1, 0.5, 0.9, 0.08}, {1.0, 0.6, 1.0, 0.9, 0.25}}, unit);
-}
-
-std::vector<SceneVolume> sceneVolumes(const std::vector<TestVolume>& volumes) {
-  std::vector<SceneVolume> out(volumes.size());
-  for (std::size_t i = 0; i < volumes.size(); ++i) {
-    out[i].name = "v" + std::to_string(i);
-    out[i].transfer = volumes[i].tf;
-    out[i].visible = volumes[i].visible;
-  }
-  return out;
-}
-
-Image castScene(const std::vector<TestVolume>& volumes, const Camera& camera, const RenderOptions& o,
-                RenderStats* stats = nullptr) {
-  std::vector<const Brick*> bricks;
-  for (const TestVolume& v : volumes) bricks.push_back(&v.brick);
-  SceneRenderer renderer(bricks);
-  renderer.classify(sceneVolumes(volumes), o);
-  return renderer.render(camera, o, pool(), stats).toFullFrame();
-}
 
 Image castOne(const Brick& brick, const TransferFunctionSpec& tf, const Camera& camera, const RenderOptions& o) {
   BrickRenderer renderer(brick);
@@ -134,13 +64,6 @@ void checkAgainstReference(const std::vector<TestVolume>& volumes, const Camera&
   CHECK(maxAlpha(ref) > 0.2);
 }
 
-Camera orthographic(Vec3 eye, Vec3 at, double height) {
-  return makeCamera(Projection::kOrthographic, eye, at, {0, 0, 1}, height, 40, 40);
-}
-Camera perspective(Vec3 eye, Vec3 at, double fovYDeg) {
-  return makeCamera(Projection::kPerspective, eye, at, {0, 0, 1}, fovYDeg, 40, 40);
-}
-
 }  // namespace
 
 // Identity: with one visible volume the scene renderer IS the brick
@@ -171,9 +94,7 @@ TEST_CASE("one visible volume renders bit for bit as the brick renderer", "[rayc
 // Identity: caster == reference for two volumes that overlap partly, with
 // different spacings (1 and 0.7), seen from outside and from inside both.
 TEST_CASE("two overlapping volumes of different spacing match the reference", "[raycast][mixed]") {
-  std::vector<TestVolume> volumes;
-  volumes.push_back({smoothVolume(boxGrid({24, 22, 20}, 1.0, {0, 0, 0}), {0.4, 0.45, 0.5}), warm(1.0)});
-  volumes.push_back({smoothVolume(boxGrid({22, 22, 22}, 0.7, {9.3, 6.1, 4.7}), {0.6, 0.5, 0.4}), cool(0.7)});
+  const std::vector<TestVolume> volumes = overlappingVolumes();
   const Vec3 c{14, 12, 10};
   SECTION("eye outside") {
     const Vec3 d = normalize(Vec3{-0.6, 0.7, -0.4});
@@ -191,9 +112,7 @@ TEST_CASE("two overlapping volumes of different spacing match the reference", "[
 // wholly inside a coarse one, from outside, from inside the outer only,
 // and from inside both.
 TEST_CASE("a volume inside another matches the reference", "[raycast][mixed]") {
-  std::vector<TestVolume> volumes;
-  volumes.push_back({smoothVolume(boxGrid({28, 28, 28}, 1.0, {0, 0, 0}), {0.3, 0.5, 0.5}), warm(1.0)});
-  volumes.push_back({smoothVolume(boxGrid({21, 19, 17}, 0.5, {9.1, 8.7, 10.3}), {0.5, 0.5, 0.5}), cool(0.5)});
+  const std::vector<TestVolume> volumes = nestedVolumes();
   const Vec3 c{13.5, 13.5, 13.5};
   SECTION("eye outside") {
     const Vec3 d = normalize(Vec3{0.7, 0.5, -0.5});
@@ -217,9 +136,7 @@ TEST_CASE("a volume inside another matches the reference", "[raycast][mixed]") {
 // other along the view (a gap between them), from outside and from inside
 // the nearer one.
 TEST_CASE("disjoint volumes side by side along the view match the reference", "[raycast][mixed]") {
-  std::vector<TestVolume> volumes;
-  volumes.push_back({smoothVolume(boxGrid({16, 16, 16}, 1.0, {0, 0, 0}), {0.5, 0.5, 0.5}), warm(1.0)});
-  volumes.push_back({smoothVolume(boxGrid({20, 20, 20}, 0.8, {20.5, 0.3, -0.4}), {0.5, 0.4, 0.6}), cool(0.8)});
+  const std::vector<TestVolume> volumes = disjointVolumes();
   SECTION("eye outside") {
     const Vec3 at{18, 7.5, 7.5};
     checkAgainstReference(volumes, perspective(at + Vec3{-40, -6, 5}, at, 30), makeOptions(1.0), 1e-2);
