@@ -384,8 +384,6 @@ proc ::pvr::gui::loadDataset {name} {
     variable tfPending
     variable rangePending
     set opt(dataset) $name
-    # Exactly this one volume: a volume list goes (docs/pvrsh.md).
-    ::pvr::gui::volumes::reset
     # Until the server has the new data's histogram (readScene).
     ::pvr::gui::tfeditor::histogram .ctl.tf.editor {} {}
     lassign [split $opt(imagesz) x] w h
@@ -393,6 +391,8 @@ proc ::pvr::gui::loadDataset {name} {
         status "dataset $name: $message" error
         return
     }
+    # Exactly this one volume: a volume list is gone (docs/pvrsh.md).
+    ::pvr::gui::volumes::reset
     ::pvr::gui::stat::clear .stat.c
     status "dataset $name"
     set rangePending 1
@@ -535,7 +535,7 @@ proc ::pvr::gui::loadPreset {file} {
         status "preset: $message" error
         return 0
     }
-    if {$::pvr::gui::volumes::listMode} {
+    if {[::pvr::gui::volumes::inList]} {
         # The server's status reports the first volume's points only: the
         # editor keeps its own, and the volume shows the preset.
         status "preset [file tail $file] on volume $::pvr::gui::volumes::selected"

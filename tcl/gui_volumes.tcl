@@ -21,8 +21,6 @@ namespace eval ::pvr::gui::volumes {
     # name -> 0 or 1, bound to the checkbuttons.
     variable visible
     array set visible {}
-    # 1 once a volume command made the session's volume list (until reset).
-    variable listMode 0
     # 1 while the editor takes a volume's points: no send for that.
     variable loading 0
 }
@@ -55,6 +53,16 @@ proc ::pvr::gui::volumes::setDatasets {names} {
     }
 }
 
+# ::pvr::gui::volumes::inList --
+#   1 when the session has a volume list (a volume command made it), 0
+#   while it shows one dataset (`set -dataset`, which then has a value) or
+#   none. Asked of the session each time, so a refused `volume add` (the
+#   session is back to what the server holds) counts as it should.
+proc ::pvr::gui::volumes::inList {} {
+    set session $::pvr::gui::session
+    expr {[$session set -dataset] eq "" && [llength [$session volume list]] > 0}
+}
+
 # ::pvr::gui::volumes::uniqueName --
 #   A volume name for dataset `dataset`: its file's stem, numbered when the
 #   scene has a volume of that name already.
@@ -74,8 +82,6 @@ proc ::pvr::gui::volumes::uniqueName {dataset} {
 #   the volume named "volume"), selects it and renders. Results: its name,
 #   or "" when the session refused the command.
 proc ::pvr::gui::volumes::add {dataset} {
-    variable listMode
-    variable selected
     set session $::pvr::gui::session
     if {!$::pvr::gui::connected} {
         ::pvr::gui::status "add volume: not connected (press Connect)" error
@@ -86,7 +92,6 @@ proc ::pvr::gui::volumes::add {dataset} {
         ::pvr::gui::status "add volume: $message" error
         return ""
     }
-    set listMode 1
     ::pvr::gui::status "volume $name: $dataset"
     refresh
     select $name
@@ -99,7 +104,6 @@ proc ::pvr::gui::volumes::add {dataset} {
 #   Rebuilds the panel's rows from `volume list` and shows the panel while
 #   the session has a volume list, hides it otherwise.
 proc ::pvr::gui::volumes::refresh {} {
-    variable listMode
     variable selected
     variable visible
     set rows .ctl.vols.rows
@@ -107,7 +111,7 @@ proc ::pvr::gui::volumes::refresh {} {
         destroy $child
     }
     array unset visible
-    set volumes [expr {$listMode ? [$::pvr::gui::session volume list] : {}}]
+    set volumes [expr {[inList] ? [$::pvr::gui::session volume list] : {}}]
     if {[llength $volumes] == 0} {
         pack forget .ctl.vols
         return
@@ -137,8 +141,7 @@ proc ::pvr::gui::volumes::refresh {} {
 #   Updates each row's description (dataset, transfer function summary)
 #   after a change that keeps the rows (a transfer function sent).
 proc ::pvr::gui::volumes::describe {} {
-    variable listMode
-    if {!$listMode} {
+    if {![inList]} {
         return
     }
     set i 0
@@ -220,9 +223,8 @@ proc ::pvr::gui::volumes::select {name} {
 #   (-tf points, -tfpreset FILE): `volume configure SELECTED` with a volume
 #   list, else `set`.
 proc ::pvr::gui::volumes::tfWords {option value} {
-    variable listMode
     variable selected
-    if {$listMode && $selected ne ""} {
+    if {$selected ne "" && [inList]} {
         return [list volume configure $selected $option $value]
     }
     return [list set $option $value]
@@ -231,9 +233,7 @@ proc ::pvr::gui::volumes::tfWords {option value} {
 # ::pvr::gui::volumes::reset --
 #   The session shows one dataset again (`set -dataset`): no list, no panel.
 proc ::pvr::gui::volumes::reset {} {
-    variable listMode
     variable selected
-    set listMode 0
     set selected ""
     if {[winfo exists .ctl.vols]} {
         refresh
