@@ -306,8 +306,9 @@ SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tc
   // top-level one would make the scene invalid (docs/scene.md, `volumes`).
   if (next.scene.contains("volumes") && change.patch.contains("transfer_function")) {
     std::string given;
+    const auto& names = transferOptionNames();
     for (const auto& [option, unused] : change.shown)
-      if (option == "-tf" || option == "-tfpreset" || option == "-unitdist") given = option;
+      if (std::find(names.begin(), names.end(), option) != names.end()) given = option;
     argsError("VOLUMES", "set " + given + ": the session has a volume list (volume list); give a volume its own with "
                          "volume configure NAME " + given + " ...");
   }
@@ -342,10 +343,14 @@ SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tc
   return change;
 }
 
+const std::vector<std::string>& transferOptionNames() {
+  static const std::vector<std::string> kNames{"-tf", "-tfpreset", "-unitdist"};
+  return kNames;
+}
+
 std::optional<json> transferOption(const std::string& option, const std::string& value, bool absolute) {
-  static const char* const kTransferOptions[] = {"-tf", "-tfpreset", "-unitdist"};
-  if (std::find(std::begin(kTransferOptions), std::end(kTransferOptions), option) == std::end(kTransferOptions))
-    return std::nullopt;
+  const auto& names = transferOptionNames();
+  if (std::find(names.begin(), names.end(), option) == names.end()) return std::nullopt;
   for (const OptionRow* o = kOptions; o->name; ++o)
     if (o->name == option) {
       Settings scratch;

@@ -70,6 +70,8 @@ SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tc
 // make, for `volume add|configure` (volume_list.h): set's parsing and
 // errors, in one place. nullopt when `option` is none of them.
 std::optional<nlohmann::json> transferOption(const std::string& option, const std::string& value, bool absolute);
+// Those options' names: {"-tf", "-tfpreset", "-unitdist"}.
+const std::vector<std::string>& transferOptionNames();
 
 // The value last given for `option` (e.g. "-imagesz"), or an error naming
 // the known options.

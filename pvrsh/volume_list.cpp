@@ -52,7 +52,8 @@ SettingsChange listChange(const Settings& settings, json list, const std::string
     change.dataset = !settings.dataset.empty();
     change.datasetName.clear();
     if (settings.scene.contains("transfer_function")) change.patch["transfer_function"] = nullptr;
-    change.forgotten = {"-dataset", "-tf", "-tfpreset", "-unitdist"};
+    change.forgotten = transferOptionNames();
+    change.forgotten.push_back("-dataset");
   }
   return change;
 }
