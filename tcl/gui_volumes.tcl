@@ -95,6 +95,9 @@ proc ::pvr::gui::volumes::add {dataset} {
     ::pvr::gui::status "volume $name: $dataset"
     refresh
     select $name
+    # The new volume shows what the editor shows: its points, over the
+    # volume's own range, go out with the frame.
+    set ::pvr::gui::tfPending 1
     ::pvr::gui::view::sceneChanged
     ::pvr::gui::requestFrame
     return $name
@@ -182,8 +185,10 @@ proc ::pvr::gui::volumes::remove {name} {
 
 # ::pvr::gui::volumes::select --
 #   The editor edits volume `name` from now on: it spans the volume's value
-#   range (the server's status, key `volumes`, when it can answer now) and
-#   shows the volume's points when it has them as points.
+#   range (the server's status, key `volumes`, when it can answer now), with
+#   the server's histogram behind it for the first volume (the only one the
+#   status counts one for) and none for another, and shows the volume's
+#   points when it has them as points.
 proc ::pvr::gui::volumes::select {name} {
     variable selected
     variable loading
@@ -198,6 +203,15 @@ proc ::pvr::gui::volumes::select {name} {
         if {!$::pvr::gui::view::busy} {
             set remote [::pvr::gui::serverStatus]
             if {[dict exists $remote volumes]} {
+                set hist {}
+                if {[dict get [lindex [dict get $remote volumes] 0] name] eq $name} {
+                    set hist [::pvr::gui::serverHistogram $remote]
+                }
+                if {[dict exists $hist edges]} {
+                    ::pvr::gui::tfeditor::histogram $editor [dict get $hist edges] [dict get $hist fractions]
+                } else {
+                    ::pvr::gui::tfeditor::histogram $editor {} {}
+                }
                 foreach v [dict get $remote volumes] {
                     if {[dict get $v name] eq $name && [dict exists $v value_range]} {
                         lassign [dict get $v value_range] lo hi

@@ -105,13 +105,16 @@ set n [llength [scenes]]
 $menu invoke 1
 sentAfter $n
 update
-set sent [lindex [scenes] end]
+set sent [lindex [scenes] $n]
 check "add: the whole list goes out, the dataset shown so far as volume \"volume\"" \
     {[lindex $sent 0] eq "" && [string match {{"transfer_function":null,"volumes":\[{"dataset":"ball","name":"volume","transfer_function":{"points":*},"visible":true},{"dataset":"cube","name":"cube","visible":true}\]}} [lindex $sent 1]]} \
     $sent
 check "add: the panel shows both volumes" \
     {[winfo ismapped .ctl.vols] && [.ctl.vols.rows.v0 cget -text] eq "volume" && [.ctl.vols.rows.v1 cget -text] eq "cube"}
 check "add: the new volume is the one edited" {$::pvr::gui::volumes::selected eq "cube"}
+check "add: the new volume takes the editor's points, as shown" \
+    {[string match {*"name":"cube","transfer_function":\{"points":\[\[0.0,0.0,0.0,0.0,0.0\],\[0.5,1.0,1.0,1.0,0.5\],*} [lindex [scenes] end 1]]} \
+    [lindex [scenes] end]
 check "add: a frame rendered after it" {[idle] && $::pvr::gui::errors == 0} $::pvr::gui::statusText
 
 # ---- 3: visibility ----
