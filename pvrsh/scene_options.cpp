@@ -65,8 +65,11 @@ struct Apply {
 
 // ---- One handler per option ----
 
+// -dataset NAME: exactly this one volume (docs/pvrsh.md, "Several
+// volumes"): a volume list set with `volume add` goes.
 void setDataset(Apply& a) {
   if (a.value.empty()) argsError("DATASET", "-dataset needs a dataset name (see list datasets)");
+  if (a.settings.scene.contains("volumes")) a.scene({{"volumes", nullptr}});
   a.settings.dataset = a.value;
   a.change.dataset = true;
   a.change.datasetName = a.value;
@@ -299,6 +302,16 @@ SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tc
     change.shown.emplace_back(option, absolute ? value + " -absolute" : value);
     if (absolute) ++i;
   }
+  // With a volume list each volume has its own transfer function: a
+  // top-level one would make the scene invalid (docs/scene.md, `volumes`).
+  if (next.scene.contains("volumes") && change.patch.contains("transfer_function")) {
+    std::string given;
+    const auto& names = transferOptionNames();
+    for (const auto& [option, unused] : change.shown)
+      if (std::find(names.begin(), names.end(), option) != names.end()) given = option;
+    argsError("VOLUMES", "set " + given + ": the session has a volume list (volume list); give a volume its own with "
+                         "volume configure NAME " + given + " ...");
+  }
   if (cluster || group) {
     // Figure 5: "-cluster r,16 -group 0,0,1,1" is four render clusters of 16
     // ranks in groups 0, 0, 1, 1; "-cluster c -group 0,0" two compositing
@@ -328,6 +341,26 @@ SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tc
   }
   settings = std::move(next);
   return change;
+}
+
+const std::vector<std::string>& transferOptionNames() {
+  static const std::vector<std::string> kNames{"-tf", "-tfpreset", "-unitdist"};
+  return kNames;
+}
+
+std::optional<json> transferOption(const std::string& option, const std::string& value, bool absolute) {
+  const auto& names = transferOptionNames();
+  if (std::find(names.begin(), names.end(), option) == names.end()) return std::nullopt;
+  for (const OptionRow* o = kOptions; o->name; ++o)
+    if (o->name == option) {
+      Settings scratch;
+      SettingsChange change;
+      const ServerNames none;
+      Apply a{scratch, change, option, value, none, absolute};
+      o->apply(a);
+      return change.patch["transfer_function"];
+    }
+  return std::nullopt;
 }
 
 std::string shownOption(Tcl_Interp* interp, const Settings& settings, Tcl_Obj* option) {
@@ -380,6 +413,10 @@ void applyChange(Settings& settings, const SettingsChange& change) {
   json patch = change.patch;
   if (patch.is_object()) patch.erase("camera_moves");
   settings.scene.merge_patch(patch);
+  for (const auto& option : change.forgotten)
+    settings.shown.erase(std::remove_if(settings.shown.begin(), settings.shown.end(),
+                                        [&](const auto& shown) { return shown.first == option; }),
+                         settings.shown.end());
   for (const auto& [option, value] : change.shown) remember(settings, option, value);
 }
 

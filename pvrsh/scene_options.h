@@ -35,6 +35,12 @@ struct SettingsChange {
   nlohmann::json patch = nlohmann::json::object();   // merge patch of the scene keys given
   bool layout = false;                               // -cluster or -group given
   std::vector<std::pair<std::string, std::string>> shown;  // option -> value as given, in order
+  // Options no longer shown by `set OPTION` (their values moved into the
+  // volume list: `volume add` on a session of one dataset).
+  std::vector<std::string> forgotten;
+  // What a refusal names: empty for `set` (its options as given are named),
+  // else the command ("volume add pet").
+  std::string command;
 };
 
 // Applies what `change` sent to `settings`: the dataset, the scene keys
@@ -58,6 +64,14 @@ using ServerNames = std::function<std::optional<std::vector<std::string>>(std::s
 // the standard "bad option" message for an unknown option.
 SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tcl_Obj* const objv[],
                             const ServerNames& serverNames);
+
+// The transfer-function options of `set` (-tf, -tfpreset with its
+// -absolute flag, -unitdist) as the "transfer_function" merge patch they
+// make, for `volume add|configure` (volume_list.h): set's parsing and
+// errors, in one place. nullopt when `option` is none of them.
+std::optional<nlohmann::json> transferOption(const std::string& option, const std::string& value, bool absolute);
+// Those options' names: {"-tf", "-tfpreset", "-unitdist"}.
+const std::vector<std::string>& transferOptionNames();
 
 // The value last given for `option` (e.g. "-imagesz"), or an error naming
 // the known options.

@@ -20,6 +20,7 @@
 //   session_status.cpp    `list status` and the server's status entries
 //   session_settled.cpp   what the server accepted of `set`, and its refusals
 //   session_commands.cpp  the subcommands (paper 003, Table 1)
+//   session_volumes.cpp   `volume add|remove|configure|list`; the list itself in volume_list.cpp
 #pragma once
 
 #include <tcl.h>

@@ -12,6 +12,7 @@
 
 #include "session.h"
 #include "session_help.h"
+#include "session_volumes.h"
 
 namespace pvr::tcl {
 namespace {
@@ -458,7 +459,7 @@ const Subcommand kSubcommands[] = {
     {"camera", cameraCmd, "", "the camera in force (automatic or set) as a dict"},
     {"cancel", cancelCmd, "", "stop the sequence in flight; returns the frames that will still come"},
     {"close", closeCmd, "", "end the session and its MPI job"},
-    {"help", helpCmd, "?subcommand?", "this help; with a subcommand, its usage (and, for set, every option)"},
+    {"help", helpCmd, "?subcommand?", "this help; with a subcommand, its usage (and, for set and volume, every option)"},
     {"image", imageCmd, "window|callback|file|dir ?value? | file movie.gif|movie.mp4 -fps n",
      "where frames go: a Tk photo, a callback, numbered files or a directory (no value: the current one);"
      " -fps: the animation's frames per second, 1 to 120 (default 10)"},
@@ -475,6 +476,8 @@ const Subcommand kSubcommands[] = {
     {"set", setCmd, "option ?value option value ...?",
      "change settings (no argument: every option with its value and default; one: its value)"},
     {"timing", timingCmd, "", "the timings of the latest sequence, one dict per frame"},
+    {"volume", volumeCmd, "add|configure|list|remove ?arg ...?",
+     "the scene's volumes, each with its own data, transfer function and visibility"},
     {"wait", waitCmd, "?-timeout seconds?", "run the event loop until the sequences and settings are done"},
     {nullptr, nullptr}};
 
@@ -485,7 +488,7 @@ const char* usageOf(Tcl_Obj* const objv[]) {
 }
 
 // :s help ?SUBCOMMAND?: every subcommand with its usage and summary, from
-// kSubcommands; one subcommand's, and for `set` every option too.
+// kSubcommands; one subcommand's, and for `set` and `volume` every option too.
 int helpCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   if (objc > 3) {
     Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
@@ -511,6 +514,7 @@ std::string subcommandHelp(const std::string& object, const std::string& subcomm
     throw TclError({"PVR", "ARGS", "SUBCOMMAND"}, "help: no subcommand \"" + subcommand + "\"; there are " + names);
   }
   if (subcommand == "set") text += "options:\n" + optionsHelp();
+  if (subcommand == "volume") text += volumeHelp(object);
   if (subcommand.empty()) text += "(" + object + " help SUBCOMMAND for one; docs/pvrsh.md and man pvrsh for more)\n";
   return text;
 }

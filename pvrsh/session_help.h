@@ -10,7 +10,8 @@ namespace pvr::tcl {
 
 // Every subcommand of the session object `object` (":s") with its usage and
 // a one-line summary, or only `subcommand`'s when it is not empty (for
-// "set", followed by every option with its value form and default).
+// "set", followed by every option with its value form and default; for
+// "volume", by its actions and their options).
 // Throws TclError {PVR ARGS SUBCOMMAND} naming the subcommands for an
 // unknown one.
 std::string subcommandHelp(const std::string& object, const std::string& subcommand);

@@ -48,8 +48,9 @@ std::optional<TclError> Session::settled(std::uint32_t id, const std::optional<T
   }
   // Refused: the settings become what the server holds, with the sets sent
   // after this one (the server applies them to its own state) on top.
-  std::string given;
-  for (const auto& [option, value] : scene->second.shown) given += " " + option + " " + value;
+  std::string given = scene->second.command.empty() ? "set" : scene->second.command;
+  if (scene->second.command.empty())
+    for (const auto& [option, value] : scene->second.shown) given += " " + option + " " + value;
   scenesSent_.erase(scene);
   Settings kept = accepted_;
   kept.clusters = settings_.clusters;
@@ -59,7 +60,7 @@ std::optional<TclError> Session::settled(std::uint32_t id, const std::optional<T
   // Until another set goes out (one sent already clears nothing: it was
   // sent before the refusal was known, and the server applied it). Set
   // before the renders stop: their `cancelled` event may ask for another.
-  refusal_ = TclError(error->code(), "set" + given + " was refused: " + error->what());
+  refusal_ = TclError(error->code(), given + " was refused: " + error->what());
   // Renders sent after the refused set would show the old settings: stopped.
   std::vector<std::uint32_t> stopped;
   for (const auto& [seq, unused] : book_.sequences)

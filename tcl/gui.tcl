@@ -7,7 +7,9 @@
 #           connection, dataset, image size, view buttons, rotation
 #           sequences, rendering controls, presets and saving
 #           (gui_render.tcl), transfer-function editor,
-#           a time slider for a series dataset, progress bar and status line
+#           a time slider for a series dataset, the scene's volumes with
+#           their visibility and the one the editor edits (gui_volumes.tcl),
+#           progress bar and status line
 #   .stat   per-frame times, one bar part per phase of ::pvr::phases (stat.tcl)
 #   .layout cluster and group configuration (gui_layout.tcl)
 #
@@ -64,7 +66,7 @@ namespace eval ::pvr::gui {
     variable timestep 0
 }
 
-foreach file {stat.tcl tfeditor.tcl gui_view.tcl gui_layout.tcl gui_fit.tcl gui_render.tcl} {
+foreach file {stat.tcl tfeditor.tcl gui_view.tcl gui_layout.tcl gui_fit.tcl gui_render.tcl gui_volumes.tcl} {
     source [file join $::pvr::gui::dir $file]
 }
 unset file
@@ -143,8 +145,12 @@ proc ::pvr::gui::buildMain {} {
         -values {256x256 384x384 512x512 640x480 768x768 1024x1024}
     bind $f.size <<ComboboxSelected>> ::pvr::gui::applyImageSize
     bind $f.size <Return> ::pvr::gui::applyImageSize
-    grid $f.dataset - -sticky we -pady 2
-    grid $f.sl $f.size -sticky w -pady 2
+    ::pvr::gui::volumes::addButton $f.addvol
+    grid $f.dataset - - -sticky we -pady 2
+    grid $f.sl $f.size $f.addvol -sticky w -pady 2 -padx 2
+
+    # The scene's volumes: shown once a volume is added (gui_volumes.tcl).
+    ::pvr::gui::volumes::build .ctl.vols
 
     # Time series: a slider over the steps, shown only for a dataset with
     # more than one (showTimeSteps).
@@ -300,6 +306,7 @@ proc ::pvr::gui::connect {} {
         set datasets {}
     }
     .ctl.data.dataset configure -values $datasets
+    ::pvr::gui::volumes::setDatasets $datasets
     set name $opt(dataset)
     if {$name ne "" && $name ni $datasets} {
         # A directory name stands for the sidecar inside it.
@@ -384,6 +391,8 @@ proc ::pvr::gui::loadDataset {name} {
         status "dataset $name: $message" error
         return
     }
+    # Exactly this one volume: a volume list is gone (docs/pvrsh.md).
+    ::pvr::gui::volumes::reset
     ::pvr::gui::stat::clear .stat.c
     status "dataset $name"
     set rangePending 1
@@ -522,9 +531,17 @@ proc ::pvr::gui::loadPreset {file} {
         return 0
     }
     set errors $::pvr::gui::errors
-    if {[catch {$session set -tfpreset $file} message]} {
+    if {[catch {$session {*}[::pvr::gui::volumes::tfWords -tfpreset $file]} message]} {
         status "preset: $message" error
         return 0
+    }
+    if {[::pvr::gui::volumes::inList]} {
+        # The server's status reports the first volume's points only: the
+        # editor keeps its own, and the volume shows the preset.
+        status "preset [file tail $file] on volume $::pvr::gui::volumes::selected"
+        ::pvr::gui::volumes::refresh
+        requestFrame
+        return 1
     }
     set remote [serverStatus]
     # A preset the server refused was reported on the status line meanwhile.
@@ -565,7 +582,7 @@ proc ::pvr::gui::loadPreset {file} {
 proc ::pvr::gui::tfChanged {points} {
     variable tfPending
     variable connected
-    if {!$connected} {
+    if {!$connected || $::pvr::gui::volumes::loading} {
         return
     }
     set tfPending 1
@@ -587,7 +604,8 @@ proc ::pvr::gui::send {args} {
     }
     if {$tfPending} {
         set tfPending 0
-        $session set -tf [::pvr::gui::tfeditor::points .ctl.tf.editor]
+        $session {*}[::pvr::gui::volumes::tfWords -tf [::pvr::gui::tfeditor::points .ctl.tf.editor]]
+        ::pvr::gui::volumes::describe
     }
     set start [clock microseconds]
     set total [$session render {*}$args]

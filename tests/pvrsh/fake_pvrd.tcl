@@ -18,8 +18,8 @@
 # `ready` sends SessionReady, `error CODE TEXT` sends Error; each carries
 # the SessionOpen's request id. ::fakepvrd::received holds, per request the
 # server read, {type id fields}: for SessionOpen the fields are
-# {rankCount clusterCount account}, for Cancel {target}, for a render
-# {frames}.
+# {rankCount clusterCount account}, for SetScene (type 18) {dataset
+# sceneJson}, for Cancel {target}, for a render {frames}.
 #
 # ::fakepvrd::renders: one entry per render request, in order (requests
 # past the list get `frames {}`):
@@ -153,7 +153,16 @@ proc ::fakepvrd::request {ch type id payload} {
         18 - 19 {
             # SetScene, SetLayout: accepted, or a SetScene answered as
             # ::fakepvrd::sceneAnswers says.
-            lappend received [list $type $id {}]
+            if {$type == 18} {
+                # str dataset, str sceneJson
+                binary scan $payload iu n
+                set dataset [encoding convertfrom utf-8 [string range $payload 4 [expr {3 + $n}]]]
+                binary scan $payload @[expr {4 + $n}]iu m
+                set json [encoding convertfrom utf-8 [string range $payload [expr {8 + $n}] [expr {7 + $n + $m}]]]
+                lappend received [list 18 $id [list $dataset $json]]
+            } else {
+                lappend received [list $type $id {}]
+            }
             variable sceneAnswers
             set answer ok
             if {$type == 18 && [llength $sceneAnswers] > 0} {

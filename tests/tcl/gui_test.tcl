@@ -44,18 +44,8 @@ foreach k {-pvrd -node -source} {
 }
 file mkdir $arg(-out)
 
-set failures 0
+source [file join [file dirname [info script]] gui_harness.tcl]
 set pvrdChan ""
-
-# check: `condition` is an expression evaluated in the caller.
-proc check {name condition {detail ""}} {
-    if {[uplevel 1 [list expr $condition]]} {
-        puts "ok   $name"
-    } else {
-        puts "FAIL $name $detail"
-        incr ::failures
-    }
-}
 
 # finish: stops pvrd (SIGTERM: it ends its sessions and their MPI jobs) and exits.
 proc finish {} {
@@ -76,19 +66,6 @@ after 140000 {
     finish
 }
 
-# waitFor: runs the event loop until `condition` (evaluated globally) holds,
-# or `seconds` pass. Results: 1 when it held.
-proc waitFor {condition seconds} {
-    set deadline [expr {[clock milliseconds] + int($seconds * 1000)}]
-    while {![uplevel #0 [list expr $condition]]} {
-        if {[clock milliseconds] > $deadline} {
-            return 0
-        }
-        after 20 {set ::tick 1}
-        vwait ::tick
-    }
-    return 1
-}
 
 # pvrtest_near: number lists A and B agree within 1e-9 element by element.
 proc pvrtest_near {a b} {
