@@ -229,7 +229,10 @@ void Master::renderSequence(int count, const std::function<core::CameraSpec(int)
     for (int k = first + groups; k < std::min(count, first + groups + kReadAheadFrames * groups) && !computed; ++k)
       wave.upcoming.push_back(stepOf(k));
     // The ranks reach the step before they render it, even if the frame fails.
-    if (computed) showComputedStep(wave.frames.back().timestep);
+    if (computed) {
+      showComputedStep(wave.frames.back().timestep);
+      publishStatus();  // what the link thread answers while the wave runs
+    }
     if (auto f = invoke(state_, wave)) {
       // A frame stopped by the Cancel fails the wave on every rank alike.
       if (link_.cancelled(id)) sendCancelled();

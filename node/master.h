@@ -64,7 +64,8 @@ class Master {
                       const std::function<int(int)>& stepOf, std::uint32_t id);
 
   // A computation volume: the session's time step becomes `step`, the one
-  // the ranks compute up to (docs/steering.md).
+  // the ranks compute up to (docs/steering.md); the wave that computes it
+  // sets the same on every rank, so their scenes stay alike.
   void showComputedStep(int step);
 
   NodeState& state_;
