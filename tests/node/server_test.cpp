@@ -1095,7 +1095,7 @@ TEST_CASE_METHOD(Fixture, "render steps: frames of the computed field equal rend
   CHECK(job.close());
 }
 
-TEST_CASE_METHOD(Fixture, "render steps on a dataset, and parameters for it, are refused; Cancel stops a computation between frames") {
+TEST_CASE_METHOD(Fixture, "render steps on a dataset, and parameters for it, are refused, and Cancel stops a computation between frames") {
   Job job(2);
   job.send(proto::SessionOpen{2, {}, ""});
   job.expect<proto::SessionReady>();
