@@ -1,7 +1,5 @@
 #include "computation_data.h"
 
-#include <charconv>
-
 namespace pvr::node {
 
 namespace {
@@ -24,11 +22,6 @@ core::Brick stepTo(NodeState& state, ComputationSource& computation, const core:
     if (state.liveness) ++state.liveness->progress;  // a long advance is not a hang
   }
   return run.brick(cluster, *parameters, core::storedBox(tree, cluster.rank(), state.ghost));
-}
-
-std::string number(double v) {
-  char text[32];
-  return std::string(text, std::to_chars(text, text + sizeof text, v).ptr);
 }
 
 }  // namespace
@@ -59,9 +52,9 @@ std::vector<proto::KeyValue> computationStatus(const NodeState& state, const Com
   // The scene's parameters were checked when it was set: the values in force.
   const Parameters inForce(entry, state.scene.parameters);
   for (const ParameterSpec& p : entry.parameters) {
-    values += (values.empty() ? "" : " ") + std::string(p.name) + " " + number(inForce[p.name]);
-    ranges += (ranges.empty() ? "{" : " {") + std::string(p.name) + " " + number(p.initial) + " " + number(p.min) +
-              " " + number(p.max) + " {" + std::string(p.help) + "}}";
+    values += (values.empty() ? "" : " ") + std::string(p.name) + " " + parameterText(inForce[p.name]);
+    ranges += (ranges.empty() ? "{" : " {") + std::string(p.name) + " " + parameterText(p.initial) + " " + parameterText(p.min) +
+              " " + parameterText(p.max) + " {" + std::string(p.help) + "}}";
   }
   return {{"computation", std::string(entry.name)},
           {"computation_summary", std::string(entry.summary)},

@@ -112,5 +112,8 @@ const std::vector<ComputationEntry>& computations();
 const ComputationEntry& computationNamed(std::string_view name);
 // "feed [0, 0.1], kill [0, 0.1]": the parameters with their ranges, for messages.
 std::string parameterRanges(const ComputationEntry& entry);
+// A parameter's value as messages and status write it: the shortest text
+// that reads back as the same double.
+std::string parameterText(double value);
 
 }  // namespace pvr::node

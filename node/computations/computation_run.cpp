@@ -96,7 +96,13 @@ void ComputationRun::place(comm::Communicator& comm, const std::vector<int>& mem
   const int layers = std::max(ghost, entry_.halo);
   const int me = comm.rank();
   const NodeBox block = grownInGrid(owned[std::size_t(me)], layers);
-  FieldBlock placed(int(entry_.fields.size()), block);
+  // Both blocks of every rank, or none: a rank without the memory must not
+  // leave the others waiting in the exchange below.
+  FieldBlock placed, next;
+  comm::runAgreed(comm, [&] {
+    placed = FieldBlock(int(entry_.fields.size()), block);
+    next = FieldBlock(int(entry_.fields.size()), block);
+  });
   if (owned_.empty() || members != members_) {
     steps_ = 0;
     // Step 0 on the owned nodes; the ghost layers come with the first step.
@@ -120,7 +126,7 @@ void ComputationRun::place(comm::Communicator& comm, const std::vector<int>& mem
   rank_ = me;
   ghost_ = layers;
   now_ = std::move(placed);
-  next_ = FieldBlock(now_.fields(), block);
+  next_ = std::move(next);
 }
 
 void ComputationRun::exchangeGhosts(comm::Communicator& comm, int layers) {

@@ -17,15 +17,14 @@ const std::vector<ComputationEntry>& computations() {
   return list;
 }
 
-namespace {
-
-// The shortest text that reads back as the same double.
-std::string number(double v) {
+std::string parameterText(double v) {
   char text[32];
   return std::string(text, std::to_chars(text, text + sizeof text, v).ptr);
 }
 
-std::string rangeOf(const ParameterSpec& p) { return "[" + number(p.min) + ", " + number(p.max) + "]"; }
+namespace {
+
+std::string rangeOf(const ParameterSpec& p) { return "[" + parameterText(p.min) + ", " + parameterText(p.max) + "]"; }
 
 }  // namespace
 
@@ -58,7 +57,7 @@ Parameters::Parameters(const ComputationEntry& entry, const std::map<std::string
                                                    parameterRanges(entry) + ")");
     const ParameterSpec& p = entry.parameters[i];
     if (!(value >= p.min && value <= p.max))
-      throw Error(ErrorCode::kInvalidArgument, "parameters." + name + ": " + number(value) +
+      throw Error(ErrorCode::kInvalidArgument, "parameters." + name + ": " + parameterText(value) +
                                                    " is outside the range " + rangeOf(p) + " of " +
                                                    std::string(entry.name) + "'s parameter '" + name + "'");
     values_[i] = value;
