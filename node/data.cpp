@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "cache_cluster.h"
+#include "computation_data.h"
 #include "data_summary.h"
 #include "decompose/content.h"
 #include "io/data_directory.h"
@@ -25,7 +26,10 @@ double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(
 // What identifies a volume: equal keys, equal data. The timestep is not
 // part of it: another step of the same dataset keeps the headers open.
 std::string volumeKeyOf(const core::VolumeSpec& v) {
-  nlohmann::json key = {{"file", v.file}, {"procedural", v.procedural}, {"dims", {v.dims.x, v.dims.y, v.dims.z}}};
+  nlohmann::json key = {{"file", v.file},
+                        {"procedural", v.procedural},
+                        {"computation", v.computation},
+                        {"dims", {v.dims.x, v.dims.y, v.dims.z}}};
   if (v.spacing) key["spacing"] = {v.spacing->x, v.spacing->y, v.spacing->z};
   return key.dump();
 }
@@ -63,7 +67,9 @@ void distributeStep(NodeState& state, int step) {
   comm::SubCommunicator& cluster = *state.clusterComm;
   // A failure agreed on the cluster already names the world rank it came from.
   Distribution d =
-      distributeBricks(state.source->step(step), state.scene, state.settings.decomposition, state.ghost, cluster);
+      computationOf(state)
+          ? distributeComputation(state, step)
+          : distributeBricks(state.source->step(step), state.scene, state.settings.decomposition, state.ghost, cluster);
   state.tree = std::move(d.tree);
   putOnScreen(state, makeReady(std::move(d.brick), step), true);
   state.cache.reset(stepReader(state));
@@ -254,7 +260,7 @@ Reload openScene(NodeState& state, const std::string& sceneJson) {
   if (changed) {
     // Only what lies inside the data directory: the client named it.
     const core::DataDirectory within(state.dataDir);
-    source = core::openSceneVolume(scene.volumes.front().source, &within);
+    source = openNodeVolume(scene.volumes.front().source, &within);
     grid = source.get();
   }
   core::checkTimestep(scene.volumes.front().source, *grid);
@@ -316,6 +322,10 @@ void distributeData(NodeState& state) {
 void showStep(NodeState& state, int step) {
   if (!state.renders() || !state.source) return;
   if (state.current && state.current->step == step) return;
+  if (computationOf(state) && state.tree) {  // computed, not read: computation_data.h
+    putOnScreen(state, makeReady(advanceComputation(state, step), step), true);
+    return;
+  }
   comm::SubCommunicator& cluster = *state.clusterComm;
   if (state.several()) {
     comm::runAgreed(cluster, [&] { checkStep(state, step); });

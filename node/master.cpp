@@ -3,9 +3,11 @@
 #include <algorithm>
 
 #include "camera_request.h"
+#include "computation_data.h"
 #include "dispatch.h"
 #include "rotation.h"
 #include "status.h"
+#include "steering_patch.h"
 #include "wire_error.h"
 
 namespace pvr::node {
@@ -19,9 +21,10 @@ using proto::ErrorCode;
 constexpr int kReadAheadFrames = 32;
 
 // Requests the master answers between the waves of a sequence (Status and
-// Cancel the link thread answers at once).
+// Cancel the link thread answers at once); steering takes effect there.
 bool answeredBetweenWaves(const proto::Message& m) {
-  return std::holds_alternative<proto::StatusRequest>(m) || std::holds_alternative<proto::PerformanceRequest>(m);
+  return std::holds_alternative<proto::StatusRequest>(m) || std::holds_alternative<proto::PerformanceRequest>(m) ||
+         isSteeringPatch(m);
 }
 
 void requireDataset(const NodeState& state) {
@@ -104,6 +107,7 @@ std::optional<proto::ProtocolError> Master::applyScene(const proto::SetScene& re
   auto patched = patchScene(scene_, request, state_.dataDir);
   if (const auto* refused = std::get_if<proto::ProtocolError>(&patched)) return *refused;
   SessionScene& next = std::get<SessionScene>(patched);
+  if (auto refused = checkSteering(request, next, state_.dataDir)) return *refused;
   // Without a volume there is nothing for the ranks to load yet: the
   // checked scene waits for the dataset.
   if (next.hasVolume()) {
@@ -143,9 +147,36 @@ void Master::on(const proto::RenderTimeSteps& m, std::uint32_t id) {
                 "render time " + std::to_string(m.first) + "," + std::to_string(m.last) + ": step " +
                     std::to_string(m.last) + " is past the last step " + std::to_string(steps - 1) + " of '" +
                     state_.source->describe() + "'");
+  if (const int now = state_.scene.volumes.front().source.timestep; computationOf(state_) && int(m.first) < now)
+    throw Error(pvr::ErrorCode::kInvalidArgument, "render time " + std::to_string(m.first) + "," +
+                                                      std::to_string(m.last) + ": '" + state_.source->describe() +
+                                                      "' is at step " + std::to_string(now) +
+                                                      " and cannot go back (docs/steering.md)");
   const core::CameraSpec camera = state_.scene.camera;
   renderSequence(int(m.frameCount()), [&](int) { return camera; },
                  [&](int k) { return int(m.first + std::uint32_t(k) * m.stride); }, id);
+}
+
+// A computation volume advances `steps` steps; frame k shows step
+// s0 + min((k + 1) * every, steps), the last the final step.
+void Master::on(const proto::RenderSteps& m, std::uint32_t id) {
+  requireDataset(state_);
+  if (!computationOf(state_))
+    throw Error(pvr::ErrorCode::kInvalidArgument,
+                "render steps: '" + state_.source->describe() +
+                    "' is not a computation volume (docs/steering.md); render time shows a dataset's steps");
+  const std::int64_t first = state_.scene.volumes.front().source.timestep;
+  if (first + std::int64_t(m.steps) > ComputationSource::kSteps)
+    throw Error(pvr::ErrorCode::kInvalidArgument, "render steps " + std::to_string(m.steps) + ": past step " +
+                                                      std::to_string(ComputationSource::kSteps));
+  const core::CameraSpec camera = state_.scene.camera;
+  renderSequence(int(m.frameCount()), [&](int) { return camera; },
+                 [&](int k) { return int(first + std::min<std::int64_t>(std::int64_t(k + 1) * m.every, m.steps)); }, id);
+}
+
+void Master::showComputedStep(int step) {
+  scene_.doc["timestep"] = step;
+  state_.scene.volumes.front().source.timestep = step;
 }
 
 void Master::on(const proto::PerformanceRequest& p, std::uint32_t id) {
@@ -185,15 +216,23 @@ void Master::renderSequence(int count, const std::function<core::CameraSpec(int)
   const auto sendCancelled = [&] {
     send(proto::ErrorMessage{ErrorCode::kCancelled, "cancelled after " + std::to_string(sent) + " frames"}, id);
   };
-  const int groups = state_.layout.groups;
+  // Groups would compute the steps of their frames apart: a computation's
+  // frames go one at a time, to the first group.
+  const bool computed = computationOf(state_) != nullptr;
+  const int groups = computed ? 1 : state_.layout.groups;
   for (int first = 0; first < count && link_.open(); first += groups) {
     actions::Wave wave;
     wave.request = id;
     wave.lastFrame = std::uint32_t(count - 1);
     for (int k = first; k < std::min(count, first + groups); ++k)
       wave.frames.push_back({std::uint32_t(k), cameraArgs(cameraOf(k)), stepOf(k)});
-    for (int k = first + groups; k < std::min(count, first + groups + kReadAheadFrames * groups); ++k)
+    for (int k = first + groups; k < std::min(count, first + groups + kReadAheadFrames * groups) && !computed; ++k)
       wave.upcoming.push_back(stepOf(k));
+    // The ranks reach the step before they render it, even if the frame fails.
+    if (computed) {
+      showComputedStep(wave.frames.back().timestep);
+      publishStatus();  // what the link thread answers while the wave runs
+    }
     if (auto f = invoke(state_, wave)) {
       // A frame stopped by the Cancel fails the wave on every rank alike.
       if (link_.cancelled(id)) sendCancelled();

@@ -43,6 +43,7 @@ class Master {
   void on(const proto::RenderFrame& m, std::uint32_t id);
   void on(const proto::RenderRotation& m, std::uint32_t id);
   void on(const proto::RenderTimeSteps& m, std::uint32_t id);
+  void on(const proto::RenderSteps& m, std::uint32_t id);
   void on(const proto::PerformanceRequest& m, std::uint32_t id);
   void on(const proto::Cancel& m, std::uint32_t id);
   void on(const proto::Close& m, std::uint32_t id);
@@ -56,9 +57,16 @@ class Master {
   // Renders frames 0 .. count - 1, frame k seen by cameraOf(k) at time
   // step stepOf(k), in waves of one frame per group; the request's frames
   // go out in order, the last FINAL. Each wave names the steps of the
-  // frames after it, for the render ranks to read ahead.
+  // frames after it, for the render ranks to read ahead. A computation
+  // volume is computed, not read: one frame per wave, and the session's
+  // step follows the frames (showComputedStep).
   void renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf,
                       const std::function<int(int)>& stepOf, std::uint32_t id);
+
+  // A computation volume: the session's time step becomes `step`, the one
+  // the ranks compute up to (docs/steering.md); the wave that computes it
+  // sets the same on every rank, so their scenes stay alike.
+  void showComputedStep(int step);
 
   NodeState& state_;
   LinkThread& link_;

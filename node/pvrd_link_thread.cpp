@@ -24,11 +24,6 @@ constexpr std::size_t kLinkBytes = std::size_t(4) << 20;
 // How long a closing link may take to hand the client what is queued.
 constexpr auto kCloseGrace = std::chrono::seconds(5);
 
-bool isRender(const proto::Message& m) {
-  return std::holds_alternative<proto::RenderFrame>(m) || std::holds_alternative<proto::RenderRotation>(m) ||
-         std::holds_alternative<proto::RenderTimeSteps>(m);
-}
-
 std::vector<std::uint8_t> encodeFinal(const proto::Message& m, std::uint32_t id, bool final = true) {
   return proto::encode(m, id, final ? proto::kFlagFinal : 0);
 }
@@ -70,7 +65,7 @@ std::optional<proto::Decoded> LinkThread::take() {
   proto::Decoded frame = std::move(requests_.front());
   requests_.pop_front();
   current_ = frame.info.requestId;
-  currentIsRender_ = isRender(frame.message);
+  currentIsRender_ = proto::isRenderRequest(frame.message);
   return frame;
 }
 
@@ -126,7 +121,7 @@ bool LinkThread::waitClosed(double seconds) {
 
 bool LinkThread::renderAhead() const {
   return rendering_ != 0 || currentIsRender_ ||
-         std::any_of(requests_.begin(), requests_.end(), [](const proto::Decoded& d) { return isRender(d.message); });
+         std::any_of(requests_.begin(), requests_.end(), [](const proto::Decoded& d) { return proto::isRenderRequest(d.message); });
 }
 
 bool LinkThread::answersStatusAtOnce() const {
@@ -135,7 +130,7 @@ bool LinkThread::answersStatusAtOnce() const {
   // its turn, to show what that request changed.
   if (current_ != 0 && !currentIsRender_) return false;
   if (current_ == 0 && requests_.empty()) return false;  // the main thread answers at once
-  return std::all_of(requests_.begin(), requests_.end(), [](const proto::Decoded& d) { return isRender(d.message); });
+  return std::all_of(requests_.begin(), requests_.end(), [](const proto::Decoded& d) { return proto::isRenderRequest(d.message); });
 }
 
 void LinkThread::dispatch(proto::Decoded frame) {

@@ -172,7 +172,7 @@ std::variant<SessionScene, ProtocolError> patchScene(const SessionScene& current
       patch.erase("runtime");
     }
     if (const auto volume = patch.find("volume"); volume != patch.end()) {
-      if (volume->is_object() && volume->contains("file"))
+      if (volume->is_object() && volume->contains("file") && !(*volume)["file"].is_null())
         return ProtocolError{ErrorCode::kBadArgument, "scene.volume.file: name a dataset, not a volume file"};
       if (volume->is_null() && current.hasVolume())
         return ProtocolError{ErrorCode::kBadArgument, "scene.volume: cannot be removed; name another dataset"};

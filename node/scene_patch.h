@@ -32,7 +32,8 @@ struct SessionScene {
 // `current` with `request` applied and checked, or the error that refuses
 // it. The dataset name resolves inside `dataDir` (a real path), to the
 // volume file the ranks open; a "volume" with a "file" in the JSON is
-// refused, so files come only through dataset names; a "paraview_preset"
+// refused (null, which removes it, is not), so files come only through
+// dataset names; a "paraview_preset"
 // resolves inside dataDir/presets. Every name resolves to a regular file
 // inside its folder after symlinks, or is refused in the same words
 // whether it exists or not. "volumes" is patched as docs/protocol.md

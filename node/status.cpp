@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 
+#include "computation_data.h"
 #include "hosts.h"
 #include "strategy.h"
 
@@ -190,7 +191,12 @@ std::vector<proto::KeyValue> statusEntries(const NodeState& state, const Session
     addDataset(state, out);
     out.push_back({"volumes", volumesText(state)});
     out.push_back({"camera_automatic", session.cameraSet ? "0" : "1"});
-    addTimeSteps(state, settings, out);
+    if (const ComputationSource* computation = computationOf(state)) {
+      const auto entries = computationStatus(state, *computation);
+      out.insert(out.end(), entries.begin(), entries.end());
+    } else {
+      addTimeSteps(state, settings, out);
+    }
   }
   return out;
 }

@@ -47,6 +47,24 @@ std::optional<ProtocolError> RenderTimeSteps::check(const Limits& limits) const 
   return std::nullopt;
 }
 
+std::optional<ProtocolError> RenderSteps::check(const Limits& limits) const {
+  const std::string what = "render " + std::to_string(steps) + " steps every " + std::to_string(every);
+  if (steps == 0) return ProtocolError{ErrorCode::kBadArgument, what + ": the steps must be at least 1"};
+  if (every == 0) return ProtocolError{ErrorCode::kBadArgument, what + ": every must be at least 1"};
+  if (frameCount() > limits.maxRotationFrames) {
+    return ProtocolError{ErrorCode::kLimitExceeded, what + " asks for " + std::to_string(frameCount()) +
+                                                        " frames, over the protocol's limit of " +
+                                                        std::to_string(limits.maxRotationFrames) +
+                                                        " frames per request"};
+  }
+  return std::nullopt;
+}
+
+bool isRenderRequest(const Message& m) {
+  return std::holds_alternative<RenderFrame>(m) || std::holds_alternative<RenderRotation>(m) ||
+         std::holds_alternative<RenderTimeSteps>(m) || std::holds_alternative<RenderSteps>(m);
+}
+
 std::optional<ProtocolError> ImageFrame::checkHead(std::uint64_t pixelBytes, const Limits& limits) const {
   const std::string size = std::to_string(width) + " x " + std::to_string(height);
   if (width == 0 || height == 0) {

@@ -291,6 +291,24 @@ struct RenderTimeSteps {
   bool operator==(const RenderTimeSteps&) const = default;
 };
 
+// Client -> server: advances the session's computation volume (docs/steering.md)
+// `steps` steps and renders one frame every `every` steps and one of the
+// last: frame k shows step s0 + min((k + 1) * every, steps), s0 being the
+// step shown before. The simulation runs on the ranks; nothing touches disk.
+struct RenderSteps {
+  static constexpr WireInfo kWire{0x25, "RenderSteps", &Limits::maxControlPayload};
+  std::uint32_t steps = 1;
+  std::uint32_t every = 1;
+  static auto fields(auto& self) { return std::tie(self.steps, self.every); }
+  // steps >= 1 and every >= 1 (kBadArgument), at most
+  // limits.maxRotationFrames frames (kLimitExceeded). Whether the volume is
+  // a computation is the server's to check.
+  std::optional<ProtocolError> check(const Limits& limits) const;
+  // ceil(steps / every); meaningful once check() passed.
+  std::uint32_t frameCount() const { return steps / every + (steps % every != 0 ? 1 : 0); }
+  bool operator==(const RenderSteps&) const = default;
+};
+
 // Server -> client: one rendered frame.
 struct ImageFrame {
   static constexpr WireInfo kWire{0x22, "ImageFrame", &Limits::maxFrameBytes};
@@ -379,7 +397,11 @@ struct CatalogReply {
 using Message = std::variant<
     Hello, Welcome, AuthChallenge, AuthResponse, Ok, ErrorMessage, Close, JobHello,
     SessionOpen, SessionReady, SetScene, SetLayout,
-    RenderFrame, RenderRotation, RenderTimeSteps, ImageFrame, Cancel,
+    RenderFrame, RenderRotation, RenderTimeSteps, RenderSteps, ImageFrame, Cancel,
     StatusRequest, StatusReply, PerformanceRequest, PerformanceReply, CatalogRequest, CatalogReply, Heartbeat>;
+
+// Whether `m` asks for frames (RenderFrame, RenderRotation, RenderTimeSteps,
+// RenderSteps): a sequence whose answers are frames, the last FINAL.
+bool isRenderRequest(const Message& m);
 
 }  // namespace pvr::proto

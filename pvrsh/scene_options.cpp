@@ -1,6 +1,7 @@
 #include "scene_options.h"
 
 #include <algorithm>
+#include <charconv>
 #include <climits>
 #include <cctype>
 #include <cmath>
@@ -39,6 +40,7 @@ struct Apply {
   const std::string& value;   // as given
   const ServerNames& serverNames;
   bool absolute = false;  // -tfpreset only: "-absolute" followed its value
+  std::string parameterValue;  // -param only: the word after NAME
 
   void scene(const json& patch) {
     mergeKeepingNulls(change.patch, patch);
@@ -70,9 +72,70 @@ struct Apply {
 void setDataset(Apply& a) {
   if (a.value.empty()) argsError("DATASET", "-dataset needs a dataset name (see list datasets)");
   if (a.settings.scene.contains("volumes")) a.scene({{"volumes", nullptr}});
+  a.settings.scene.erase("volume");  // a -computation before: the dataset replaces it
   a.settings.dataset = a.value;
   a.change.dataset = true;
   a.change.datasetName = a.value;
+}
+
+// -computation NAME?,NX,NY,NZ?: a user computation run on the ranks in
+// place of a dataset (docs/steering.md), on a grid of NX x NY x NZ nodes
+// (default 64 each). Which computations exist is the server's to say.
+void setComputation(Apply& a) {
+  const auto comma = a.value.find(',');
+  const std::string name = a.value.substr(0, comma);
+  if (name.empty()) argsError("COMPUTATION", "-computation needs a computation name (list status: computation)");
+  json dims = nullptr;
+  if (comma != std::string::npos) {
+    const auto n = parseNumbers("-computation", a.value.substr(comma + 1), 3);
+    dims = json::array();
+    for (double d : n) {
+      if (d < 1 || d != std::floor(d) || d > INT32_MAX)
+        argsError("COMPUTATION", "-computation NAME,NX,NY,NZ needs whole node counts >= 1, got '" + a.value + "'");
+      dims.push_back(std::int64_t(d));
+    }
+  }
+  a.settings.dataset.clear();
+  a.scene({{"volume", {{"computation", name}, {"dims", dims}, {"file", nullptr}, {"procedural", nullptr}}}});
+}
+
+// The Tcl list {name default min max help} of each parameter the server's
+// computation declares (status key parameter_ranges), or nullopt.
+std::optional<std::vector<std::string>> parameterRow(const ServerNames& names, const std::string& parameter) {
+  const auto rows = names ? names("parameter_ranges") : std::nullopt;
+  if (!rows) return std::nullopt;
+  for (const std::string& row : *rows) {
+    int count = 0;
+    const char** items = nullptr;
+    if (Tcl_SplitList(nullptr, row.c_str(), &count, &items) != TCL_OK) continue;
+    std::vector<std::string> fields(items, items + count);
+    Tcl_Free(reinterpret_cast<char*>(items));
+    if (fields.size() == 5 && fields[0] == parameter) return fields;
+  }
+  return std::vector<std::string>{};
+}
+
+// -param NAME VALUE: the computation's steering parameter NAME ("parameters"
+// of the scene). With a session open and idle, NAME and the range come from
+// the server's status for a clear error here; otherwise the server refuses
+// a name or value it does not take, naming the parameter and its range.
+void setParameter(Apply& a) {
+  if (a.value.empty()) argsError("PARAM", "-param needs NAME VALUE");
+  const double v = parseNumbers("-param " + a.value, a.parameterValue, 1)[0];
+  if (const auto row = parameterRow(a.serverNames, a.value)) {
+    if (row->empty()) {
+      std::string known;
+      for (const std::string& r : a.serverNames("parameter_ranges").value_or(std::vector<std::string>{}))
+        known += (known.empty() ? "" : ", ") + r.substr(0, r.find(' '));
+      argsError("PARAM", "-param " + a.value + ": the computation has no such parameter" +
+                             (known.empty() ? std::string(" (no computation volume is set)") : " (its parameters: " + known + ")"));
+    }
+    const double lo = std::stod((*row)[2]), hi = std::stod((*row)[3]);
+    if (!(v >= lo && v <= hi))
+      argsError("PARAM", "-param " + a.value + " " + a.parameterValue + ": outside the range [" + (*row)[2] + ", " +
+                             (*row)[3] + "] of parameter '" + a.value + "'");
+  }
+  a.scene({{"parameters", {{a.value, v}}}});
 }
 
 // -cluster ROLE[,RANKS]: ROLE r (render), c (composite), k (collector) or
@@ -263,6 +326,8 @@ const OptionRow kOptions[] = {
     {"-decomposition", [](Apply& a) { setRuntimeName(a, "decomposition", "decompositions"); }, "NAME", "kd"},
     {"-timestep", setTimestep, "K", "0"},
     {"-cachemem", setCacheMemory, "MB", "256"},
+    {"-computation", setComputation, "NAME?,NX,NY,NZ?", "none: a dataset (64,64,64 nodes when not given)"},
+    {"-param", setParameter, "NAME VALUE", "the computation's own (list status: parameter_ranges)"},
     {nullptr, nullptr}};
 
 void remember(Settings& s, const std::string& option, const std::string& value) {
@@ -290,17 +355,31 @@ SettingsChange applyOptions(Tcl_Interp* interp, Settings& settings, int objc, Tc
     const std::string value = Tcl_GetString(objv[i + 1]);
     // "-tfpreset FILE -absolute": a flag, the one option word without a value.
     const bool absolute = option == "-tfpreset" && i + 2 < objc && std::string_view(Tcl_GetString(objv[i + 2])) == "-absolute";
+    // "-param NAME VALUE": the one option of two words.
+    const bool parameter = option == "-param";
+    if (parameter && i + 2 >= objc) argsError("VALUE", "-param " + value + ": the value is missing (-param NAME VALUE)");
+    const std::string parameterValue = parameter ? Tcl_GetString(objv[i + 2]) : "";
     if (option == "-cluster") {
       cluster = value;
     } else if (option == "-group") {
       group = value;
     } else {
-      Apply a{next, change, option, value, serverNames, absolute};
+      Apply a{next, change, option, value, serverNames, absolute, parameterValue};
       kOptions[index].apply(a);
     }
-    remember(next, option, absolute ? value + " -absolute" : value);
-    change.shown.emplace_back(option, absolute ? value + " -absolute" : value);
-    if (absolute) ++i;
+    // -param shows every parameter given so far, NAME VALUE ...
+    std::string shown = absolute ? value + " -absolute" : value;
+    if (parameter) {
+      shown.clear();
+      for (const auto& [name, v] : next.scene["parameters"].items()) {
+        char text[32];
+        char* end = std::to_chars(text, text + sizeof text, v.get<double>()).ptr;
+        shown += (shown.empty() ? "" : " ") + name + " " + std::string(text, std::size_t(end - text));
+      }
+    }
+    remember(next, option, shown);
+    change.shown.emplace_back(option, shown);
+    if (absolute || parameter) ++i;
   }
   // With a volume list each volume has its own transfer function: a
   // top-level one would make the scene invalid (docs/scene.md, `volumes`).

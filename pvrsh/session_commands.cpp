@@ -297,9 +297,33 @@ proto::RenderTimeSteps parseTimeRange(Session& s, const std::string& range) {
   return t;
 }
 
+// :s render steps N ?-every K?: the session's computation volume advances
+// N steps, a frame every K-th step and one of the last (docs/steering.md).
+// The protocol's check applies before sending; whether the volume is a
+// computation is the server's to say.
+int renderSteps(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
+  if (objc != 4 && objc != 6) {
+    Tcl_WrongNumArgs(interp, 3, objv, "n ?-every k?");
+    return TCL_ERROR;
+  }
+  proto::RenderSteps r;
+  std::string label = "steps " + str(objv[3]);
+  r.steps = std::uint32_t(parseInteger("-steps", str(objv[3]), 1, UINT32_MAX));
+  if (objc == 6) {
+    if (str(objv[4]) != "-every") argsError("STEPS", "render steps: expected -every K, got '" + str(objv[4]) + "'");
+    r.every = std::uint32_t(parseInteger("-every", str(objv[5]), 1, UINT32_MAX));
+    label += " -every " + str(objv[5]);
+  }
+  if (const auto error = r.check(proto::Limits{})) argsError("STEPS", "render steps: " + error->text);
+  s.render(r, r.frameCount(), label);
+  Tcl_SetObjResult(interp, Tcl_NewWideIntObj(r.frameCount()));
+  return TCL_OK;
+}
+
 // :s render rotate|rotation X,Y,Z S,E:N  |  :s render time S,E?:STRIDE?  |  :s render frame
+// |  :s render steps N ?-every K?
 int renderCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
-  static const char* const kKinds[] = {"frame", "rotate", "rotation", "time", nullptr};
+  static const char* const kKinds[] = {"frame", "rotate", "rotation", "time", "steps", nullptr};
   if (objc < 3) {
     Tcl_WrongNumArgs(interp, 2, objv, usageOf(objv));
     return TCL_ERROR;
@@ -307,6 +331,7 @@ int renderCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   int kind = 0;
   if (Tcl_GetIndexFromObj(interp, objv[2], kKinds, "render", 0, &kind) != TCL_OK)
     throw TclError({"PVR", "ARGS", "RENDER"}, Tcl_GetStringResult(interp));
+  if (kind == 4) return renderSteps(s, interp, objc, objv);
   if (kind == 3) {
     if (objc != 4) {
       Tcl_WrongNumArgs(interp, 3, objv, "start,end?:stride?");
@@ -471,8 +496,9 @@ const Subcommand kSubcommands[] = {
     {"performance", performanceCmd,
      "memory ?cluster? ?index? | comp ?cluster? ?latency? ?index? | cache ?cluster? ?index?",
      "memory, compositing or cache figures of the clusters"},
-    {"render", renderCmd, "rotate axis start,end:steps | time start,end?:stride? | frame",
-     "render one frame, a rotation or time steps; returns the number of frames"},
+    {"render", renderCmd, "rotate axis start,end:steps | time start,end?:stride? | steps n ?-every k? | frame",
+     "render one frame, a rotation, time steps, or a computation's next n steps (a frame every k-th and of the "
+     "last); returns the number of frames"},
     {"set", setCmd, "option ?value option value ...?",
      "change settings (no argument: every option with its value and default; one: its value)"},
     {"timing", timingCmd, "", "the timings of the latest sequence, one dict per frame"},

@@ -14,6 +14,7 @@
 #include <chrono>
 
 #include "../cache_cluster.h"
+#include "../computation_data.h"
 #include "../data.h"
 #include "../rank_watch.h"
 #include "../wave_collect.h"
@@ -91,6 +92,10 @@ void Wave::run(NodeState& state, const Wave& args) {
     w.timestep = f.timestep;
     state.wave.push_back(std::move(w));
   }
+  // A computation's frames compute their steps: every rank's scene shows
+  // the last, as the master's does (Master::showComputedStep).
+  if (computationOf(state) && !args.frames.empty())
+    state.scene.volumes.front().source.timestep = args.frames.back().timestep;
   std::optional<comm::Failure> failure;
   {
     const comm::LivenessScope loading(state.liveness, comm::LivenessScope::Kind::kLoading);

@@ -113,24 +113,33 @@ class ProceduralSource final : public VolumeSource {
 
 }  // namespace
 
-std::unique_ptr<VolumeSource> openProcedural(const std::string& name, IVec3 dims, Vec3 spacing) {
-  const Field& field = findField(name);
+GridGeometry generatedGrid(IVec3 dims, std::optional<Vec3> spacing, const std::string& name) {
   GridGeometry grid;
   grid.dims = dims;
-  grid.spacing = spacing;
+  if (spacing) {
+    grid.spacing = *spacing;
+  } else {
+    // [-1, 1] on the longest axis; a single node has no extent to span, and
+    // any positive spacing would do.
+    const std::int64_t longest = std::max({dims.x, dims.y, dims.z});
+    const double h = longest > 1 ? 2.0 / double(longest - 1) : 2.0;
+    grid.spacing = Vec3{h, h, h};
+  }
   // Centred on 0: node i sits at (i - (n - 1) / 2) * spacing.
-  for (int a = 0; a < 3; ++a) grid.origin[a] = -double(dims[a] - 1) * spacing[a] / 2;
+  for (int a = 0; a < 3; ++a) grid.origin[a] = -double(dims[a] - 1) * grid.spacing[a] / 2;
   grid.validate(name);
   voxelBytes(grid, ScalarType::kFloat32, name);  // refuses absurd sizes
-  return std::make_unique<ProceduralSource>(field, grid);
+  return grid;
+}
+
+std::unique_ptr<VolumeSource> openProcedural(const std::string& name, IVec3 dims, Vec3 spacing) {
+  const Field& field = findField(name);
+  return std::make_unique<ProceduralSource>(field, generatedGrid(dims, spacing, name));
 }
 
 std::unique_ptr<VolumeSource> openProcedural(const std::string& name, IVec3 dims) {
-  // [-1, 1] on the longest axis; a single node has no extent to span, and
-  // any positive spacing would do.
-  const std::int64_t longest = std::max({dims.x, dims.y, dims.z});
-  const double h = longest > 1 ? 2.0 / double(longest - 1) : 2.0;
-  return openProcedural(name, dims, Vec3{h, h, h});
+  const Field& field = findField(name);
+  return std::make_unique<ProceduralSource>(field, generatedGrid(dims, std::nullopt, name));
 }
 
 std::vector<std::string> proceduralNames() {

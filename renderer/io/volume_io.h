@@ -8,6 +8,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,12 @@ std::string writeRawJsonVolume(const Brick& volume, const std::string& dir, cons
 std::unique_ptr<VolumeSource> openProcedural(const std::string& name, IVec3 dims);
 std::unique_ptr<VolumeSource> openProcedural(const std::string& name, IVec3 dims, Vec3 spacing);
 std::vector<std::string> proceduralNames();
+
+// The grid of a generated volume (procedural, or a user computation on the
+// ranks): `dims` nodes centred on the origin, spanning [-1, 1] on the
+// longest axis with isotropic spacing unless `spacing` is given. Throws
+// pvr::Error naming `name` for an invalid grid or one of absurd size.
+GridGeometry generatedGrid(IVec3 dims, std::optional<Vec3> spacing, const std::string& name);
 
 // The analytic field a procedural volume samples, at a world position (the
 // grid puts node (i,j,k) at origin + (i,j,k) * spacing). Reference

@@ -2,8 +2,8 @@
 # loops over strategies x decompositions x views inside a single job (MPI
 # start-up costs ~0.5 s per job), and pvr-node --batch against pvr-render.
 if(TARGET pvr_comm_mpi AND TARGET pvr-node)
-  add_executable(pvr_node_mpi_driver mpi_driver.cpp)
-  target_link_libraries(pvr_node_mpi_driver PRIVATE pvr_node_frame pvr_image_io pvr_comm_mpi ZLIB::ZLIB)
+  add_executable(pvr_node_mpi_driver mpi_driver.cpp steering_checks.cpp)
+  target_link_libraries(pvr_node_mpi_driver PRIVATE pvr_node_frame pvr_node_computations pvr_image_io pvr_comm_mpi ZLIB::ZLIB)
   set(PVR_MPI_ENV OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1)
   set(PVR_MPIRUN ${MPIEXEC_EXECUTABLE} --oversubscribe --bind-to none)
   set(PVR_MPI_SCRATCH ${CMAKE_CURRENT_BINARY_DIR}/scratch)
@@ -15,6 +15,16 @@ if(TARGET pvr_comm_mpi AND TARGET pvr-node)
                      matrix ${PVR_MPI_SCRATCH}/matrix-${ranks})
     set_tests_properties("node mpi: ${ranks} ranks equal the single-process render"
                          PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 240 PROCESSORS 2)
+  endforeach()
+
+  # The steering example (node/computations/gray_scott.cpp) over 1..4 ranks
+  # equals a serial run of the same steps, steered or not.
+  foreach(ranks RANGE 1 4)
+    add_test(NAME "node mpi: ${ranks} ranks of the Gray-Scott computation equal the serial run"
+             COMMAND ${PVR_MPIRUN} -np ${ranks} $<TARGET_FILE:pvr_node_mpi_driver>
+                     steering ${PVR_MPI_SCRATCH}/steering-${ranks})
+    set_tests_properties("node mpi: ${ranks} ranks of the Gray-Scott computation equal the serial run"
+                         PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 60 PROCESSORS 2)
   endforeach()
 
   # One rank's brick read throws: all fail alike, nothing deadlocks.

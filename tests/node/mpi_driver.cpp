@@ -7,6 +7,8 @@
 //                                          count and the paper's pixel bound
 //   pvr_composite_mpi_driver failure DIR   a rank whose brick read throws: every rank
 //                                          fails with the same message, nothing hangs
+//   pvr_composite_mpi_driver steering DIR  the Gray-Scott computation over the ranks
+//                                          equals a serial run (steering_checks.cpp)
 //   pvr_composite_mpi_driver compare A.exr B.exr TOL   (serial) max abs difference <= TOL
 //
 // DIR is a scratch directory for the volumes the driver writes. Exit 0 when
@@ -26,6 +28,9 @@
 #include "mpi_communicator.h"
 #include "raycast/raycaster.h"
 #include "scene_volume.h"
+
+// steering_checks.cpp: the example computation, distributed against serial.
+int steering(pvr::comm::Communicator& comm);
 
 namespace {
 
@@ -308,13 +313,14 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "compare: %s\n", e.what());
     return 1;
   }
-  if ((mode != "matrix" && mode != "failure") || argc != 3) {
-    std::fprintf(stderr, "usage: %s matrix|failure DIR | compare A.exr B.exr TOL\n", argv[0]);
+  if ((mode != "matrix" && mode != "failure" && mode != "steering") || argc != 3) {
+    std::fprintf(stderr, "usage: %s matrix|failure|steering DIR | compare A.exr B.exr TOL\n", argv[0]);
     return 2;
   }
   comm::MpiEnvironment mpi(&argc, &argv);
   comm::Communicator& comm = mpi.world();
   try {
+    if (mode == "steering") return steering(comm);  // steering_checks.cpp
     const fs::path dir = argv[2];
     if (comm.rank() == 0) fs::create_directories(dir);
     comm.barrier();

@@ -114,6 +114,14 @@ TEST_CASE("datasets resolve inside the data directory, volume files in the JSON 
   CHECK(accepted({}, {"", R"({"volume": {"procedural": "shepp-logan", "dims": [8, 8, 8]}})"}).hasVolume());
 }
 
+TEST_CASE("a dataset's volume gives way to a computation volume whose patch removes the file with null") {
+  const SessionScene loaded = accepted({}, {"ct.json", ""});
+  const SessionScene next =
+      accepted(loaded, {"", R"({"volume": {"computation": "gray-scott", "dims": [8, 8, 8], "file": null}})"});
+  CHECK_FALSE(next.doc["volume"].contains("file"));
+  CHECK(next.doc["volume"]["computation"] == "gray-scott");
+}
+
 TEST_CASE("runtime null resets the settings to their defaults") {
   const SessionScene set = accepted({}, {"", R"({"runtime": {"threads": 4, "compression": "rle"}})"});
   CHECK(set.settings.compression == proto::Compression::kRle);

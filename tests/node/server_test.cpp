@@ -31,7 +31,9 @@
 #include <thread>
 
 #include "camera.h"
+#include "computation_run.h"
 #include "frame_pixels.h"
+#include "in_process_communicator.h"
 #include "io/volume_io.h"
 #include "pvr_protocol.h"
 #include "raycast/raycaster.h"
@@ -1169,5 +1171,143 @@ TEST_CASE_METHOD(Fixture, "new ghost layers are read with a compositing cluster 
   job.expect<proto::Ok>();
   id = job.send(proto::RenderFrame{});
   checkSequence(job, id, 1, 1, Reference(nlohmann::json::parse(R"({"shading": {"enabled": false}})")));
+// ---- Steering: a computation volume (docs/steering.md) ----
+
+namespace {
+
+// The Gray-Scott computation of the steering tests, and the field it draws (v).
+const char* kComputationScene = R"({
+  "volume": {"computation": "gray-scott", "dims": [22, 20, 18], "file": null},
+  "transfer_function": {"points": [[0, 0, 0, 0, 0], [0.05, 0.2, 0.5, 1, 0.1], [0.3, 1, 0.9, 0.4, 0.9]]},
+  "image": {"width": 64, "height": 64, "background": [0, 0, 0, 1]},
+  "shading": {"enabled": false}})";
+
+// The computation run serially in this process, one rank holding the
+// whole grid; `at` dumps its drawn field as a raw volume with a JSON
+// sidecar in the data directory, for Reference to render as pvr-render would.
+class SerialComputation {
+ public:
+  SerialComputation() : world_(1), comm_(world_, 0), run_(node::computationNamed("gray-scott"), grid()) {
+    run_.place(comm_, {0}, {run_.grid().allNodes()}, 1);
+  }
+  // Runs to `step` with `parameters`; returns the dumped file's name.
+  std::string at(int step, const std::map<std::string, double>& parameters = {}) {
+    const node::Parameters p(run_.entry(), parameters);
+    while (run_.steps() < step) run_.step(comm_, p);
+    const std::string stem = "gray-scott-" + std::to_string(::getpid()) + "-" + std::to_string(step);
+    core::writeRawJsonVolume(run_.brick(comm_, p, run_.grid().allNodes()), (kTmp / "data").string(), stem,
+                             "gray-scott step " + std::to_string(step));
+    return stem + ".json";
+  }
+
+ private:
+  static core::GridGeometry grid() { return core::generatedGrid({22, 20, 18}, std::nullopt, "gray-scott"); }
+  comm::InProcessWorld world_;
+  comm::InProcessCommunicator comm_;
+  node::ComputationRun run_;
+};
+
+// The frames of a computation's request: frame k equals Reference of the
+// serial run's field dumped at steps[k].
+void checkComputedFrames(Job& job, std::uint32_t request, SerialComputation& serial, const std::vector<int>& steps,
+                         const std::map<std::string, double>& parameters = {}) {
+  const nlohmann::json patch = nlohmann::json::parse(kComputationScene);
+  checkFrames(job, request, int(steps.size()), [&](int k) {
+    nlohmann::json rest = patch;
+    rest.erase("volume");
+    return Reference(rest, serial.at(steps[std::size_t(k)], parameters)).frame(0, 1);
+  });
+}
+
+}  // namespace
+
+TEST_CASE_METHOD(Fixture, "render steps: frames of the computed field equal renderings of the field dumped to a file, steered from the next step") {
+  Job job(3);
+  job.send(proto::SessionOpen{3, {}, ""});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetScene{"", kComputationScene});
+  job.expect<proto::Ok>();
+  auto status = statusOf(job);
+  CHECK(status["computation"] == "gray-scott");
+  CHECK(status["step"] == "0");
+  CHECK_THAT(status["parameters"], Catch::StartsWith("feed 0.035 kill 0.065"));
+  CHECK_THAT(status["parameter_ranges"], Catch::Contains("{feed 0.035 0 0.1 {"));
+
+  // Parameters the computation does not declare, or out of range, are
+  // refused naming the parameter and its range; nothing changes.
+  job.send(proto::SetScene{"", R"({"parameters": {"feed": 0.5}})"});
+  auto refused = job.expectError();
+  CHECK(refused.code == proto::ErrorCode::kBadArgument);
+  CHECK(refused.text == "parameters.feed: 0.5 is outside the range [0, 0.1] of gray-scott's parameter 'feed'");
+  job.send(proto::SetScene{"", R"({"parameters": {"fed": 0.05}})"});
+  refused = job.expectError();
+  CHECK_THAT(refused.text, Catch::StartsWith("parameters.fed: gray-scott has no parameter 'fed' (its parameters: "
+                                             "feed [0, 0.1], kill [0, 0.1]"));
+  CHECK(statusOf(job)["parameters"] == status["parameters"]);
+
+  // 7 steps, a frame every 3: steps 3, 6 and the last, 7.
+  SerialComputation serial;
+  auto id = job.send(proto::RenderSteps{7, 3});
+  checkComputedFrames(job, id, serial, {3, 6, 7});
+  CHECK(statusOf(job)["step"] == "7");
+  // A frame shows the step the session is at; it does not advance.
+  id = job.send(proto::RenderFrame{});
+  checkComputedFrames(job, id, serial, {7});
+
+  // Steered: feed changes from step 8 on.
+  job.send(proto::SetScene{"", R"({"parameters": {"feed": 0.06}})"});
+  job.expect<proto::Ok>();
+  CHECK_THAT(statusOf(job)["parameters"], Catch::StartsWith("feed 0.06 "));
+  id = job.send(proto::RenderSteps{2, 1});
+  checkComputedFrames(job, id, serial, {8, 9}, {{"feed", 0.06}});
+
+  // A computation cannot go back; a dataset's time request says so.
+  job.send(proto::RenderTimeSteps{0, 2, 1});
+  CHECK_THAT(job.expectError().text, Catch::Contains("is at step 9 and cannot go back"));
+  CHECK(job.close());
+}
+
+TEST_CASE_METHOD(Fixture, "render steps on a dataset, and parameters for it, are refused, and Cancel stops a computation between frames") {
+  Job job(2);
+  job.send(proto::SessionOpen{2, {}, ""});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  job.send(proto::RenderSteps{3, 1});
+  CHECK_THAT(job.expectError().text, Catch::Contains("is not a computation volume"));
+  job.send(proto::SetScene{"", R"({"parameters": {"feed": 0.05}})"});
+  CHECK_THAT(job.expectError().text, Catch::StartsWith("parameters: only a computation volume takes parameters"));
+
+  job.send(proto::SetScene{"", kComputationScene});
+  job.expect<proto::Ok>();
+  const auto render = job.send(proto::RenderSteps{100000, 1});
+  auto first = job.receive();
+  REQUIRE(first);
+  REQUIRE(std::holds_alternative<proto::ImageFrame>(first->message));
+  const auto cancel = job.send(proto::Cancel{render});
+  std::optional<proto::ErrorMessage> ended;
+  bool ok = false;
+  int frames = 1;
+  while (!ended || !ok) {
+    auto d = job.receive(120);
+    REQUIRE(d);
+    if (d->info.requestId == cancel) {
+      ok = true;
+    } else if (const auto* e = std::get_if<proto::ErrorMessage>(&d->message)) {
+      ended = *e;
+    } else {
+      REQUIRE(std::holds_alternative<proto::ImageFrame>(d->message));
+      ++frames;
+    }
+  }
+  CHECK(ended->code == proto::ErrorCode::kCancelled);
+  // The session is at the step of the last frame it sent, or the one after
+  // it (a frame cancelled once its steps were computed), and goes on from there.
+  const int step = std::stoi(statusOf(job)["step"]);
+  CHECK(step >= frames);
+  CHECK(step <= frames + 1);
+  SerialComputation serial;
+  const auto id = job.send(proto::RenderSteps{1, 1});
+  checkComputedFrames(job, id, serial, {step + 1});
   CHECK(job.close());
 }

@@ -160,6 +160,11 @@ std::vector<HostileCase> hostileCases() {
        "the last step is below the first"},
       {"time steps of one frame too many", encode(RenderTimeSteps{0, kMaxRotationFrames, 1}, 1),
        ErrorCode::kLimitExceeded, "limit of " + std::to_string(kMaxRotationFrames) + " frames"},
+      // A computation's steps (RenderSteps::check).
+      {"computed steps of 0 steps", encode(RenderSteps{0, 1}, 1), ErrorCode::kBadArgument, "the steps must be at least 1"},
+      {"computed steps every 0", encode(RenderSteps{5, 0}, 1), ErrorCode::kBadArgument, "every must be at least 1"},
+      {"computed steps of one frame too many", encode(RenderSteps{kMaxRotationFrames + 1, 1}, 1),
+       ErrorCode::kLimitExceeded, "limit of " + std::to_string(kMaxRotationFrames) + " frames"},
   };
 }
 
