@@ -100,47 +100,55 @@ ExtinctionTable::ExtinctionTable(const TransferFunctionSpec& tf, double step) {
   }
 }
 
-PreintegratedTable::PreintegratedTable(const TransferFunctionSpec& tf, double step) {
-  requireUsable(tf, step);
+PreintegratedTable::PreintegratedTable(const TransferFunctionSpec& tf) {
+  requireUsable(tf, 1.0);
   const TableDomain domain(tf, kEntries);
   domain.mapping(scale_, offset_);
   const int n = kEntries;
-
-  // The medium on a fine scalar grid (8 sub-entries per entry), so a
-  // segment's integral resolves the transfer function between entries.
-  const int fine = 8 * (n - 1) + 1;
-  std::vector<Medium> media(fine);
-  for (int i = 0; i < fine; ++i) media[i] = evaluateMedium(tf, domain.scalar(double(i) / 8.0));
-
-  entries_.resize(std::size_t(n) * n);
-  for (int f = 0; f < n; ++f) {
-    for (int b = 0; b < n; ++b) {
-      // Walk the scalar linearly from front to back in sub-segments of
-      // constant medium, each integrated exactly, front to back.
-      const int fi = 8 * f, bi = 8 * b;
-      // One sub-segment per table entry crossed keeps the build near 10^7
-      // steps; each reads the medium between fine-grid points.
-      const int steps = std::max(1, std::abs(b - f));
-      const double dl = step / steps;
-      double r = 0, g = 0, bl = 0, transmit = 1;
-      for (int k = 0; k < steps; ++k) {
-        // Mid-point of sub-segment k on the fine grid (a half index away from both ends).
-        const double pos = fi + (bi - fi) * (k + 0.5) / steps;
-        const int i0 = int(std::floor(pos));
-        const double w = pos - i0;
-        const Medium& m0 = media[std::clamp(i0, 0, fine - 1)];
-        const Medium& m1 = media[std::clamp(i0 + 1, 0, fine - 1)];
-        const double tau = m0.tau + w * (m1.tau - m0.tau);
-        const double alpha = -std::expm1(-tau * dl);
-        const double weight = transmit * alpha;
-        r += weight * (m0.r + w * (m1.r - m0.r));
-        g += weight * (m0.g + w * (m1.g - m0.g));
-        bl += weight * (m0.b + w * (m1.b - m0.b));
-        transmit *= 1 - alpha;
-      }
-      entries_[std::size_t(f) * n + b] = {float(r), float(g), float(bl), float(1 - transmit)};
-    }
+  // Table coordinates per world scalar unit are folded into the integrals:
+  // T and K are integrals over the table coordinate, and so is the
+  // segment's difference quotient (preintegration.h).
+  nodes_.resize(n);
+  opaqueColour_.resize(2 * std::size_t(n));
+  for (int i = 0; i < n; ++i) {
+    const Medium m = evaluateMedium(tf, domain.scalar(i));
+    PreintegralNode& node = nodes_[i];
+    // Opacity 1 is kept out of the sums (its extinction is infinite); the
+    // colour an opaque segment shows is recorded apart below.
+    const bool opaque = m.tau >= 1e30;
+    node.tau = opaque ? 0.0 : m.tau;
+    const double c[3] = {m.r, m.g, m.b};
+    for (int k = 0; k < 3; ++k) node.k[k] = node.tau * c[k];
+    node.opaque = opaque ? 1.0 : 0.0;
+    opaqueColour_[2 * std::size_t(i)] = opaqueColour_[2 * std::size_t(i) + 1] =
+        opaque ? Rgba{float(m.r), float(m.g), float(m.b), 1.0f} : Rgba{};
   }
+  // Cumulative integrals of the piecewise-linear node values (trapezoids).
+  nodes_[0].T = nodes_[0].O = 0;
+  for (int k = 0; k < 3; ++k) nodes_[0].K[k] = 0;
+  for (int i = 1; i < n; ++i) {
+    const PreintegralNode& a = nodes_[i - 1];
+    PreintegralNode& b = nodes_[i];
+    b.T = a.T + 0.5 * (a.tau + b.tau);
+    for (int k = 0; k < 3; ++k) b.K[k] = a.K[k] + 0.5 * (a.k[k] + b.k[k]);
+    b.O = a.O + 0.5 * (a.opaque + b.opaque);
+  }
+  // The nearest opaque node at or below each node, then at or above it.
+  for (int i = 1; i < n; ++i)
+    if (nodes_[i].opaque == 0) opaqueColour_[2 * std::size_t(i)] = opaqueColour_[2 * std::size_t(i - 1)];
+  for (int i = n - 2; i >= 0; --i)
+    if (nodes_[i].opaque == 0)
+      opaqueColour_[2 * std::size_t(i) + 1] = opaqueColour_[2 * std::size_t(i + 1) + 1];
+}
+
+PreintegralTables PreintegratedTable::tables() const {
+  PreintegralTables t;
+  t.nodes = nodes_.data();
+  t.opaqueColour = opaqueColour_.data();
+  t.entries = int(nodes_.size());
+  t.scale = scale_;
+  t.offset = offset_;
+  return t;
 }
 
 }  // namespace pvr::core

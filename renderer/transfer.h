@@ -8,17 +8,18 @@
 // split classifies a scalar identically. Non-finite scalars never reach a
 // table: the kernels classify them as empty before the look-up.
 //
-// A PreintegratedTable holds, for pairs (s_front, s_back) of the scalars at
-// the ends of a ray segment of length h, the colour and opacity of that
-// segment with the scalar varying linearly along it (Engel et al. 2001),
-// integrated with self-attenuation, so sharp transfer functions stay
-// accurate at large steps.
+// A PreintegratedTable holds what pre-integration needs to integrate a
+// ray segment whose scalar varies linearly between its ends exactly, for
+// any step: the cumulative integrals of the extinction and of the
+// extinction-weighted colour over the scalar (preintegration.h). It does
+// not depend on the step, and building it costs what the plain table does.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
 #include "image.h"
+#include "preintegration.h"
 #include "scene.h"
 
 namespace pvr::core {
@@ -78,19 +79,18 @@ class ExtinctionTable {
 
 class PreintegratedTable {
  public:
-  static constexpr int kEntries = 256;
+  static constexpr int kEntries = TransferTable::kEntries;
 
   PreintegratedTable() = default;
-  PreintegratedTable(const TransferFunctionSpec& tf, double step);
+  explicit PreintegratedTable(const TransferFunctionSpec& tf);
 
-  float scale() const { return scale_; }
-  float offset() const { return offset_; }
-  // Row-major [front][back], kEntries x kEntries.
-  const Rgba* entries() const { return entries_.data(); }
+  // Valid while this table lives and is not moved from.
+  PreintegralTables tables() const;
 
  private:
   float scale_ = 0, offset_ = 0;
-  std::vector<Rgba> entries_;
+  std::vector<PreintegralNode> nodes_;
+  std::vector<Rgba> opaqueColour_;
 };
 
 }  // namespace pvr::core

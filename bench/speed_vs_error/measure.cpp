@@ -208,6 +208,28 @@ double loadAverage1() {
   return load;
 }
 
+RebuildTimes rebuildTimes(const BenchScene& scene, int repeats, core::ThreadPool& pool) {
+  const core::Scene& s = scene.scene();
+  const core::TransferFunctionSpec& tf = s.volumes.front().transfer;
+  core::RenderOptions options = core::renderOptionsFor(s);
+  options.preintegrated = true;
+  core::BrickRenderer renderer(scene.volume());
+  std::vector<double> table, classify;
+  for (int i = 0; i < repeats; ++i) {
+    auto started = Clock::now();
+    const core::PreintegratedTable built(tf);
+    table.push_back(secondsSince(started));
+    started = Clock::now();
+    renderer.classify(tf, options, &pool);
+    classify.push_back(secondsSince(started));
+  }
+  auto median = [](std::vector<double>& v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+  };
+  return {median(table), median(classify)};
+}
+
 CaseResult measureCase(const BenchScene& scene, const Case& c, const Reference& reference,
                        int frames, double capSeconds, double orbitDegrees, core::ThreadPool& pool) {
   const core::Scene& s = scene.scene();

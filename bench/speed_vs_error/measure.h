@@ -117,4 +117,12 @@ core::CameraSpec azimuth(const core::CameraSpec& camera, double degrees);
 
 double loadAverage1();
 
+// What a transfer-function change costs with pre-integration on: building
+// the pre-integration table alone, and the renderer's whole classify()
+// (both tables and the macrocells' visibility), medians of `repeats`.
+struct RebuildTimes {
+  double table = 0, classify = 0;  // seconds
+};
+RebuildTimes rebuildTimes(const BenchScene& scene, int repeats, core::ThreadPool& pool);
+
 }  // namespace pvr::bench

@@ -235,6 +235,46 @@ class CsvWriter {
   std::ofstream out_;
 };
 
+// Pre-integration against plain sampling, skipping on, from one scene's
+// sweep: at each step both errors, whether pre-integration is no worse,
+// how its error at 2h compares with plain's at h, and its time over
+// plain's at the same step.
+struct SweepRow {
+  SweepCase sc;
+  CaseResult r;
+};
+void printPreintegration(const std::vector<SweepRow>& rows, const bench::RebuildTimes& rebuild,
+                         double voxel) {
+  auto find = [&](double steps, bool pre) -> const CaseResult* {
+    for (const SweepRow& row : rows)
+      if (row.sc.c.skipEmpty && row.sc.c.preintegrated == pre &&
+          std::abs(row.sc.c.step / voxel - steps) <= 1e-9 * steps)
+        return &row.r;
+    return nullptr;
+  };
+  std::printf("  pre-integration (skipping on): rebuild on a transfer-function change %.2f ms "
+              "(table) %.2f ms (classify)\n",
+              rebuild.table * 1e3, rebuild.classify * 1e3);
+  std::printf("  %-6s %11s %11s %-7s %13s %-7s %9s\n", "step h", "plain RMSE", "preint RMSE",
+              "p<=pl", "preint at 2h", "2h<=h", "time p/pl");
+  for (const SweepRow& row : rows) {
+    const Case& c = row.sc.c;
+    if (!c.skipEmpty || c.preintegrated) continue;
+    const double h = c.step / voxel;
+    const CaseResult* pre = find(h, true);
+    if (!pre) continue;
+    const CaseResult* pre2h = find(2 * h, true);
+    char twice[64] = "-", verdict[8] = "-";
+    if (pre2h) {
+      std::snprintf(twice, sizeof twice, "%.3e", pre2h->error.rmse);
+      std::snprintf(verdict, sizeof verdict, "%s", pre2h->error.rmse <= row.r.error.rmse ? "yes" : "NO");
+    }
+    std::printf("  %-6.4g %11.3e %11.3e %-7s %13s %-7s %9.2f\n", h, row.r.error.rmse,
+                pre->error.rmse, pre->error.rmse <= row.r.error.rmse ? "yes" : "NO", twice, verdict,
+                row.r.timing.median > 0 ? pre->timing.median / row.r.timing.median : 0.0);
+  }
+}
+
 int runSweep(const Args& args) {
   core::ThreadPool pool(args.threads);
   fs::create_directories(fs::path(args.csv).parent_path());
@@ -254,6 +294,7 @@ int runSweep(const Args& args) {
     printReference(ref, scene);
     std::printf("  %-6s %-8s %-4s %9s %9s %9s %10s %8s %9s %5s\n", "step", "classify", "skip",
                 "s/frame", "Msamp/s", "per core", "RMSE", "PSNR dB", "max abs", "load");
+    std::vector<SweepRow> rows;
     for (const SweepCase& sc : sweepCases(args, scene)) {
       const CaseResult r =
           bench::measureCase(scene, sc.c, ref, args.frames, args.caseSeconds, 0, pool);
@@ -264,7 +305,9 @@ int runSweep(const Args& args) {
                   r.error.psnr, r.error.maxAbs, r.load1, sc.own ? "  <- scene's own settings" : "");
       std::fflush(stdout);
       csv.row(scene, sc, r, ref, pool.size());
+      rows.push_back({sc, r});
     }
+    printPreintegration(rows, bench::rebuildTimes(scene, 9, pool), scene.voxel());
   }
   std::printf("\nwrote %s\n", args.csv.c_str());
   return 0;

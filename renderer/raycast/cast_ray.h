@@ -20,8 +20,11 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
   const float o0 = float(ray.origin[0]), o1 = float(ray.origin[1]), o2 = float(ray.origin[2]);
   const float d0 = float(ray.step[0]), d1 = float(ray.step[1]), d2 = float(ray.step[2]);
   float front = 0;
-  if constexpr (kPreintegrated)
+  preint::End frontEnd;
+  if constexpr (kPreintegrated) {
     front = around(v, p, o0 + float(start) * d0, o1 + float(start) * d1, o2 + float(start) * d2);
+    frontEnd = segmentEnd<T>(p, front);
+  }
   for (std::int64_t s = start; s < exit; ++s) {
     const float x0 = o0 + float(s) * d0, x1 = o1 + float(s) * d1, x2 = o2 + float(s) * d2;
     Rgba c;
@@ -29,8 +32,11 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
       // Sample s + 1's position by the same formula as every sample's, so a
       // run that starts at s + 1 reads exactly the value carried here.
       const float back = around(v, p, o0 + float(s + 1) * d0, o1 + float(s + 1) * d1, o2 + float(s + 1) * d2);
-      c = finite<T>(front) && finite<T>(back) ? classify2D(p, front, back) : Rgba{};
+      const preint::End backEnd = segmentEnd<T>(p, back);
+      c = finite<T>(front) && finite<T>(back) ? preint::segment(p.preint, frontEnd, backEnd, p.stepLength)
+                                              : Rgba{};
       front = back;
+      frontEnd = backEnd;
     } else {
       const float value = trilinear(v, p, x0, x1, x2, p.ownCellLo, p.ownCellHi);
       c = finite<T>(value) ? classify1D(p, value) : Rgba{};
@@ -38,7 +44,14 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
     ++samples;
     if constexpr (kShaded) {
       if (!(c.a > 0)) continue;
-      c = shade(v, p, ray, x0, x1, x2, c);
+      // Pre-integrated: lit at the segment's middle, where the plain
+      // kernel's segment has its sample (second-order accurate).
+      if constexpr (kPreintegrated) {
+        const float t = float(s) + 0.5f;
+        c = shade(v, p, ray, o0 + t * d0, o1 + t * d1, o2 + t * d2, c);
+      } else {
+        c = shade(v, p, ray, x0, x1, x2, c);
+      }
     }
     acc.addBehind(c);
     if (acc.a >= p.earlyTermination) return true;
@@ -47,11 +60,12 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
 }
 
 // One sample standing for the segment [from, to] of the ray (in steps),
-// composited into acc: classified at `at` (plain) or pre-integrated from
-// `from` to `to`, shaded at `at`, then stretched from one step to the
-// segment's length. `at` is a sample this brick owns (or a short chord's
-// midpoint), and `from` and `to` lie within a step of it, so every read
-// stays within the ghost layers. Returns true at early termination.
+// composited into acc: plain, classified and shaded at `at`, then
+// stretched from one step to the segment's length; pre-integrated from
+// `from` to `to` over the segment's own length and shaded at its middle.
+// `at` is a sample this brick owns (or a short chord's midpoint), and
+// `from` and `to` lie within a step of it, so every read stays within the
+// ghost layers (ghostLayers()). Returns true at early termination.
 // Out of line and cold: it runs at most twice per ray.
 template <typename T, bool kShaded, bool kPreintegrated>
 [[gnu::noinline, gnu::cold]] bool runSegment(const KernelParams& p, const RaySetup& ray,
@@ -62,15 +76,19 @@ template <typename T, bool kShaded, bool kPreintegrated>
     for (int a = 0; a < 3; ++a) x[a] = float(ray.origin[a] + k * ray.step[a]);
   };
   float x[3];
-  position(at, x);
   Rgba c;
   if constexpr (kPreintegrated) {
+    // Integrated over its own length: no stretching; lit at its middle.
     float f[3], b[3];
     position(from, f);
     position(to, b);
+    position(0.5 * (from + to), x);
     const float front = around(v, p, f[0], f[1], f[2]), back = around(v, p, b[0], b[1], b[2]);
-    if (finite<T>(front) && finite<T>(back)) c = classify2D(p, front, back);
+    if (finite<T>(front) && finite<T>(back))
+      c = preint::segment(p.preint, segmentEnd<T>(p, front), segmentEnd<T>(p, back),
+                          (to - from) * p.stepLength);
   } else {
+    position(at, x);
     const float value = trilinear(v, p, x[0], x[1], x[2], p.ownCellLo, p.ownCellHi);
     if (finite<T>(value)) c = classify1D(p, value);
   }
@@ -78,7 +96,8 @@ template <typename T, bool kShaded, bool kPreintegrated>
   if constexpr (kShaded) {
     if (c.a > 0) c = shade(v, p, ray, x[0], x[1], x[2], c);
   }
-  acc.addBehind(stretch(c, to - from));
+  if constexpr (!kPreintegrated) c = stretch(c, to - from);
+  acc.addBehind(c);
   return acc.a >= p.earlyTermination;
 }
 
@@ -106,8 +125,18 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
   const std::int64_t body = std::min(exit, ends.last);
   if (start < body) {
 #ifdef PVR_HAVE_BATCH_KERNEL
-    if constexpr (!kPreintegrated) {
-      if (p.indices32 && runBatched<T, kShaded>(p, ray, start, body, acc, samples)) return true;
+    if (p.indices32) {
+      if constexpr (kPreintegrated) {
+        const T* v = static_cast<const T*>(p.voxels);
+        float front = around(v, p, float(ray.origin[0]) + float(start) * float(ray.step[0]),
+                             float(ray.origin[1]) + float(start) * float(ray.step[1]),
+                             float(ray.origin[2]) + float(start) * float(ray.step[2]));
+        preint::End frontEnd = segmentEnd<T>(p, front);
+        if (runBatchedPreintegrated<T, kShaded>(p, ray, start, body, front, frontEnd, acc, samples))
+          return true;
+      } else {
+        if (runBatched<T, kShaded>(p, ray, start, body, acc, samples)) return true;
+      }
     }
 #endif
     if (runScalar<T, kShaded, kPreintegrated>(p, ray, start, body, acc, samples)) return true;

@@ -13,6 +13,7 @@
 #include <type_traits>
 
 #include "../image.h"
+#include "../preintegration.h"
 
 namespace pvr::core {
 
@@ -39,9 +40,11 @@ struct KernelParams {
   const std::uint8_t* distance = nullptr;  // MacrocellGrid::distance(): 0 = visible
   int mcFirst[3], mcCount[3];
   // Classification.
-  const Rgba* table = nullptr;  // TransferTable or PreintegratedTable entries
+  const Rgba* table = nullptr;  // TransferTable entries (plain)
   int tableEntries = 0;
   float tableScale = 0, tableOffset = 0;
+  PreintegralTables preint;  // pre-integration's integral tables
+  double stepLength = 0;     // world length of one step, h
   float earlyTermination = 1;
   // Shading (world space).
   float ambient = 0, diffuse = 0, specular = 0, shininess = 1;
@@ -130,15 +133,11 @@ inline Rgba lerp(const Rgba& a, const Rgba& b, float w) {
   return lerp(p.table[i], p.table[i + 1], x - float(i));
 }
 
-[[gnu::always_inline]] inline Rgba classify2D(const KernelParams& p, float front, float back) {
-  const int n = p.tableEntries;
-  const float x = std::clamp(front * p.tableScale + p.tableOffset, 0.0f, float(n - 1));
-  const float y = std::clamp(back * p.tableScale + p.tableOffset, 0.0f, float(n - 1));
-  const int i = std::min(int(x), n - 2), j = std::min(int(y), n - 2);
-  const Rgba* row0 = p.table + std::int64_t(i) * n;
-  const Rgba* row1 = row0 + n;
-  const float wy = y - float(j);
-  return lerp(lerp(row0[j], row0[j + 1], wy), lerp(row1[j], row1[j + 1], wy), x - float(i));
+// The integrals at a pre-integrated segment's end. A non-finite scalar is
+// looked up as 0: the caller, who knows, makes its segments empty.
+template <typename T>
+[[gnu::always_inline]] inline preint::End segmentEnd(const KernelParams& p, float value) {
+  return preint::endAt(p.preint, finite<T>(value) ? value : 0.0f);
 }
 
 // Central differences of the reconstructed field at a sample at least one

@@ -139,6 +139,74 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
   return false;
 }
 
+// The scalars at samples [first, first + 8) as `around` reads them
+// (positions clamped into the domain, cells into the stored box): a
+// pre-integrated segment's ends may lie beyond the owned box.
+template <typename T>
+[[gnu::always_inline]] inline __m256 aroundBatch(const T* v, const KernelParams& p, const __m256 o[3],
+                                                 const __m256 d[3], std::int64_t first) {
+  const __m256 k = _mm256_add_ps(_mm256_set1_ps(float(first)), _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7));
+  __m256 f[3];
+  __m256i cell[3];
+  for (int a = 0; a < 3; ++a) {
+    const __m256 u = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(k, d[a], o[a]), _mm256_setzero_ps()),
+                                   _mm256_set1_ps(p.domainMax[a]));
+    cell[a] = clampCells8(u, p.storedCellLo[a], p.storedCellHi[a]);
+    f[a] = _mm256_sub_ps(u, _mm256_cvtepi32_ps(cell[a]));
+  }
+  alignas(32) std::int32_t index[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(index),
+                     _mm256_add_epi32(_mm256_add_epi32(cell[0], _mm256_set1_epi32(std::int32_t(p.base))),
+                                      _mm256_add_epi32(_mm256_mullo_epi32(cell[1], _mm256_set1_epi32(std::int32_t(p.strideY))),
+                                                       _mm256_mullo_epi32(cell[2], _mm256_set1_epi32(std::int32_t(p.strideZ))))));
+  __m256 a0, a1, b0, b1, c0, c1, e0, e1;
+  loadPairs8(v, index, 0, a0, a1);
+  loadPairs8(v, index, p.strideY, b0, b1);
+  loadPairs8(v, index, p.strideZ, c0, c1);
+  loadPairs8(v, index, p.strideY + p.strideZ, e0, e1);
+  return lerp8(lerp8(lerp8(a0, a1, f[0]), lerp8(b0, b1, f[0]), f[1]),
+               lerp8(lerp8(c0, c1, f[0]), lerp8(e0, e1, f[0]), f[1]), f[2]);
+}
+
+// Pre-integrated segments [s, s + 1) for s in [start, exit), eight at a
+// time while eight remain: the eight back ends' scalars in one batch, the
+// segments (preintegration.h) and the "over" per segment in order. `front`
+// and `frontEnd` carry the front end of segment `start` in and the front of
+// the next segment out; `start` advances past what was done. Returns true
+// at the early-termination opacity.
+template <typename T, bool kShaded>
+inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
+                                    std::int64_t exit, float& front, preint::End& frontEnd,
+                                    Accumulator& acc, std::uint64_t& samples) {
+  const T* v = static_cast<const T*>(p.voxels);
+  const __m256 o[3] = {_mm256_set1_ps(float(ray.origin[0])), _mm256_set1_ps(float(ray.origin[1])),
+                       _mm256_set1_ps(float(ray.origin[2]))};
+  const __m256 d[3] = {_mm256_set1_ps(float(ray.step[0])), _mm256_set1_ps(float(ray.step[1])),
+                       _mm256_set1_ps(float(ray.step[2]))};
+  for (std::int64_t s = start; s + 8 <= exit; s += 8, start = s) {
+    alignas(32) float back[8];
+    _mm256_store_ps(back, aroundBatch(v, p, o, d, s + 1));
+    for (int lane = 0; lane < 8; ++lane) {
+      const preint::End backEnd = segmentEnd<T>(p, back[lane]);
+      Rgba c = finite<T>(front) && finite<T>(back[lane])
+                   ? preint::segment(p.preint, frontEnd, backEnd, p.stepLength)
+                   : Rgba{};
+      front = back[lane];
+      frontEnd = backEnd;
+      if constexpr (kShaded) {
+        if (!(c.a > 0)) continue;
+        const float t = float(s + lane) + 0.5f;
+        c = shade(v, p, ray, float(ray.origin[0]) + t * float(ray.step[0]),
+                  float(ray.origin[1]) + t * float(ray.step[1]), float(ray.origin[2]) + t * float(ray.step[2]), c);
+      }
+      acc.addBehind(c);
+    }
+    samples += 8;
+    if (acc.a >= p.earlyTermination) return true;
+  }
+  return false;
+}
+
 }  // namespace pvr::core::kernel
 
 #endif

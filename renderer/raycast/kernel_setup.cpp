@@ -42,6 +42,16 @@ void ownRegion(KernelParams& p, const GridGeometry& grid, const WorldRegion& reg
   }
 }
 
+void setTables(KernelParams& p, const TransferTable& table, const PreintegratedTable* preintegrated,
+               double step) {
+  p.table = table.entries();
+  p.tableEntries = TransferTable::kEntries;
+  p.tableScale = table.scale();
+  p.tableOffset = table.offset();
+  p.preint = preintegrated ? preintegrated->tables() : PreintegralTables{};
+  p.stepLength = step;
+}
+
 void setOptions(KernelParams& p, const RenderOptions& options, const float* specularTable) {
   p.earlyTermination = float(std::clamp(options.earlyTermination, 0.0, 1.0));
   p.ambient = float(options.shading.ambient);

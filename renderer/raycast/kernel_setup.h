@@ -24,6 +24,12 @@ void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocel
 // where the region reaches beyond the domain (raycaster.h, restrictTo).
 void ownRegion(KernelParams& p, const GridGeometry& grid, const WorldRegion& region);
 
+// The one-volume classification: the plain table, the pre-integration
+// tables when there are any (null: plain), and the step's world length.
+// Both tables must outlive p.
+void setTables(KernelParams& p, const TransferTable& table, const PreintegratedTable* preintegrated,
+               double step);
+
 // Early termination and shading parameters of `options`. `specularTable`
 // (specularTable() of the same shininess) must outlive p.
 void setOptions(KernelParams& p, const RenderOptions& options, const float* specularTable);

@@ -44,8 +44,12 @@ RenderOptions renderOptionsFor(const Scene& scene) {
 
 int ghostLayers(const GridGeometry& grid, const RenderOptions& options) {
   int layers = options.shading.enabled ? 1 : 0;
-  if (options.preintegrated)
-    layers = std::max(layers, int(std::ceil(options.step / grid.minSpacing() - 1e-9)));
+  if (options.preintegrated) {
+    const double steps = options.step / grid.minSpacing();
+    layers = std::max(layers, int(std::ceil(steps - 1e-9)));
+    // Lit at a segment's middle, half a step beyond the last owned sample.
+    if (options.shading.enabled) layers = std::max(layers, int(std::ceil(0.5 * steps - 1e-9)) + 1);
+  }
   return layers;
 }
 
@@ -54,7 +58,7 @@ BrickRenderer::BrickRenderer(const Brick& brick, ThreadPool* pool) : brick_(bric
 void BrickRenderer::classify(const TransferFunctionSpec& tf, const RenderOptions& options, ThreadPool* pool) {
   table_ = TransferTable(tf, options.step);
   preintegrated_.reset();
-  if (options.preintegrated) preintegrated_ = std::make_unique<PreintegratedTable>(tf, options.step);
+  if (options.preintegrated) preintegrated_ = std::make_unique<PreintegratedTable>(tf);
   macrocells_.classify(table_, options.skipEmpty, pool);
   classifiedStep_ = options.step;
 }
@@ -92,17 +96,7 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   KernelParams p;
   setBrick(p, brick_, macrocells_);
   if (region_) ownRegion(p, grid, *region_);
-  if (preintegrated_) {
-    p.table = preintegrated_->entries();
-    p.tableEntries = PreintegratedTable::kEntries;
-    p.tableScale = preintegrated_->scale();
-    p.tableOffset = preintegrated_->offset();
-  } else {
-    p.table = table_.entries();
-    p.tableEntries = TransferTable::kEntries;
-    p.tableScale = table_.scale();
-    p.tableOffset = table_.offset();
-  }
+  setTables(p, table_, preintegrated_.get(), options.step);
   const std::vector<float> specular = specularTable(options.shading.shininess);
   setOptions(p, options, specular.data());
   const RayFunction cast = pickKernel(brick_.type(), options.shading.enabled, bool(preintegrated_));
