@@ -124,6 +124,15 @@ void Master::on(const proto::RenderFrame&, std::uint32_t id) {
   renderSequence(1, [&](int) { return camera; }, [&](int) { return step; }, id);
 }
 
+// The coarse frame, then the same view at full quality (a wave of its
+// own, which a newer request stops or skips).
+void Master::on(const proto::RenderInteractive& m, std::uint32_t id) {
+  requireDataset(state_);
+  const core::CameraSpec camera = m.turn == 0 ? state_.scene.camera : Rotation(state_.scene.camera, m.rotation()).camera(0);
+  const int step = state_.scene.volumes.front().source.timestep;
+  renderSequence(2, [&](int) { return camera; }, [&](int) { return step; }, id, int(m.reduction));
+}
+
 // A rotation shows the session's time step.
 void Master::on(const proto::RenderRotation& m, std::uint32_t id) {
   const Rotation rotation(state_.scene.camera, m);
@@ -172,7 +181,7 @@ void Master::on(const M&, std::uint32_t id) {
 }
 
 void Master::renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf,
-                            const std::function<int(int)>& stepOf, std::uint32_t id) {
+                            const std::function<int(int)>& stepOf, std::uint32_t id, int coarse) {
   running_ = id;
   publishStatus();
   link_.setRendering(id);
@@ -185,10 +194,16 @@ void Master::renderSequence(int count, const std::function<core::CameraSpec(int)
   const auto sendCancelled = [&] {
     send(proto::ErrorMessage{ErrorCode::kCancelled, "cancelled after " + std::to_string(sent) + " frames"}, id);
   };
-  const int groups = state_.layout.groups;
+  const bool progressive = coarse > 1;
+  const int groups = progressive ? 1 : state_.layout.groups;
   for (int first = 0; first < count && link_.open(); first += groups) {
+    if (progressive && first > 0 && link_.giveWayToNewer(id)) {
+      sendCancelled();
+      break;
+    }
     actions::Wave wave;
     wave.request = id;
+    wave.reduction = progressive && first == 0 ? coarse : 1;
     wave.lastFrame = std::uint32_t(count - 1);
     for (int k = first; k < std::min(count, first + groups); ++k)
       wave.frames.push_back({std::uint32_t(k), cameraArgs(cameraOf(k)), stepOf(k)});

@@ -43,6 +43,7 @@ class Master {
   void on(const proto::RenderFrame& m, std::uint32_t id);
   void on(const proto::RenderRotation& m, std::uint32_t id);
   void on(const proto::RenderTimeSteps& m, std::uint32_t id);
+  void on(const proto::RenderInteractive& m, std::uint32_t id);
   void on(const proto::PerformanceRequest& m, std::uint32_t id);
   void on(const proto::Cancel& m, std::uint32_t id);
   void on(const proto::Close& m, std::uint32_t id);
@@ -56,9 +57,12 @@ class Master {
   // Renders frames 0 .. count - 1, frame k seen by cameraOf(k) at time
   // step stepOf(k), in waves of one frame per group; the request's frames
   // go out in order, the last FINAL. Each wave names the steps of the
-  // frames after it, for the render ranks to read ahead.
+  // frames after it, for the render ranks to read ahead. `coarse` > 1:
+  // progressively (proto::RenderInteractive), one frame per wave, frame 0
+  // at 1/coarse of the pixels per axis, and every later frame given up
+  // for a newer request (LinkThread::giveWayToNewer).
   void renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf,
-                      const std::function<int(int)>& stepOf, std::uint32_t id);
+                      const std::function<int(int)>& stepOf, std::uint32_t id, int coarse = 1);
 
   NodeState& state_;
   LinkThread& link_;

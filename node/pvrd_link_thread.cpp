@@ -24,9 +24,11 @@ constexpr std::size_t kLinkBytes = std::size_t(4) << 20;
 // How long a closing link may take to hand the client what is queued.
 constexpr auto kCloseGrace = std::chrono::seconds(5);
 
-bool isRender(const proto::Message& m) {
-  return std::holds_alternative<proto::RenderFrame>(m) || std::holds_alternative<proto::RenderRotation>(m) ||
-         std::holds_alternative<proto::RenderTimeSteps>(m);
+// A request that asks the master for work, which an interactive render's
+// full-quality frame gives way to (giveWayToNewer); queries do not.
+bool asksForWork(const proto::Message& m) {
+  return !std::holds_alternative<proto::StatusRequest>(m) && !std::holds_alternative<proto::PerformanceRequest>(m) &&
+         !std::holds_alternative<proto::CatalogRequest>(m);
 }
 
 std::vector<std::uint8_t> encodeFinal(const proto::Message& m, std::uint32_t id, bool final = true) {
@@ -70,7 +72,7 @@ std::optional<proto::Decoded> LinkThread::take() {
   proto::Decoded frame = std::move(requests_.front());
   requests_.pop_front();
   current_ = frame.info.requestId;
-  currentIsRender_ = isRender(frame.message);
+  currentIsRender_ = proto::isRenderRequest(frame.message);
   return frame;
 }
 
@@ -101,6 +103,15 @@ void LinkThread::send(const proto::Message& m, std::uint32_t id, bool final) {
 void LinkThread::setRendering(std::uint32_t id) {
   const std::lock_guard lock(mutex_);
   rendering_ = id;
+  givesWay_ = 0;
+}
+
+bool LinkThread::giveWayToNewer(std::uint32_t id) {
+  const std::lock_guard lock(mutex_);
+  if (std::any_of(requests_.begin(), requests_.end(), [](const proto::Decoded& d) { return asksForWork(d.message); }))
+    return true;
+  givesWay_ = id;
+  return false;
 }
 
 void LinkThread::publishStatus(proto::StatusReply status) {
@@ -126,7 +137,7 @@ bool LinkThread::waitClosed(double seconds) {
 
 bool LinkThread::renderAhead() const {
   return rendering_ != 0 || currentIsRender_ ||
-         std::any_of(requests_.begin(), requests_.end(), [](const proto::Decoded& d) { return isRender(d.message); });
+         std::any_of(requests_.begin(), requests_.end(), [](const proto::Decoded& d) { return proto::isRenderRequest(d.message); });
 }
 
 bool LinkThread::answersStatusAtOnce() const {
@@ -135,7 +146,7 @@ bool LinkThread::answersStatusAtOnce() const {
   // its turn, to show what that request changed.
   if (current_ != 0 && !currentIsRender_) return false;
   if (current_ == 0 && requests_.empty()) return false;  // the main thread answers at once
-  return std::all_of(requests_.begin(), requests_.end(), [](const proto::Decoded& d) { return isRender(d.message); });
+  return std::all_of(requests_.begin(), requests_.end(), [](const proto::Decoded& d) { return proto::isRenderRequest(d.message); });
 }
 
 void LinkThread::dispatch(proto::Decoded frame) {
@@ -185,8 +196,10 @@ void LinkThread::dispatch(proto::Decoded frame) {
                         id));
     return;
   }
+  const bool newer = asksForWork(frame.message);
   requests_.push_back(std::move(frame));
   changed_.notify_all();
+  if (newer && givesWay_ != 0 && givesWay_ == current_) stopCurrent();
 }
 
 void LinkThread::run() {

@@ -47,6 +47,19 @@ std::optional<ProtocolError> RenderTimeSteps::check(const Limits& limits) const 
   return std::nullopt;
 }
 
+std::optional<ProtocolError> RenderInteractive::check(const Limits& limits) const {
+  if (reduction < 2 || reduction > kMaxInteractiveReduction)
+    return ProtocolError{ErrorCode::kBadArgument, "interactive render with reduction " + std::to_string(reduction) +
+                                                      "; it must be 2 to " +
+                                                      std::to_string(kMaxInteractiveReduction) + " pixels per axis"};
+  return rotation().check(limits);
+}
+
+bool isRenderRequest(const Message& m) {
+  return std::holds_alternative<RenderFrame>(m) || std::holds_alternative<RenderRotation>(m) ||
+         std::holds_alternative<RenderTimeSteps>(m) || std::holds_alternative<RenderInteractive>(m);
+}
+
 std::optional<ProtocolError> ImageFrame::checkHead(std::uint64_t pixelBytes, const Limits& limits) const {
   const std::string size = std::to_string(width) + " x " + std::to_string(height);
   if (width == 0 || height == 0) {

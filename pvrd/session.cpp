@@ -302,9 +302,7 @@ void Session::onClient(proto::Decoded frame) {
     }
     return forward(proto::SetScene{std::get<std::string>(resolved), scene->sceneJson}, id);
   }
-  if (std::holds_alternative<proto::RenderFrame>(m) || std::holds_alternative<proto::RenderRotation>(m) ||
-      std::holds_alternative<proto::RenderTimeSteps>(m))
-    rendering_.insert(id);
+  if (proto::isRenderRequest(m)) rendering_.insert(id);
   forward(m, id);
 }
 

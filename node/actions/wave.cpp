@@ -14,6 +14,7 @@
 #include <chrono>
 
 #include "../cache_cluster.h"
+#include "../coarse_frame.h"
 #include "../data.h"
 #include "../rank_watch.h"
 #include "../wave_collect.h"
@@ -91,6 +92,8 @@ void Wave::run(NodeState& state, const Wave& args) {
     w.timestep = f.timestep;
     state.wave.push_back(std::move(w));
   }
+  // Every step of a coarse wave works at the reduced size.
+  const ReducedImage reduced(state.scene.image, std::max<std::int32_t>(1, args.reduction));
   std::optional<comm::Failure> failure;
   {
     const comm::LivenessScope loading(state.liveness, comm::LivenessScope::Kind::kLoading);
@@ -98,7 +101,7 @@ void Wave::run(NodeState& state, const Wave& args) {
   }
   renderMyFrame(state, args, failure);
   compositeWave(state, failure);
-  collectWave(state, args.request, args.lastFrame, failure);
+  collectWave(state, args.request, args.lastFrame, reduced.full(), failure);
   if (failure) throw comm::FailureError(*failure);
 }
 
