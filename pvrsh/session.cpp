@@ -43,9 +43,7 @@ void Session::requireOpen(const char* what) const {
 
 std::uint32_t Session::send(const proto::Message& message, bool synchronous) {
   const std::uint32_t id = nextId_++;
-  if (!std::holds_alternative<proto::RenderFrame>(message) && !std::holds_alternative<proto::RenderRotation>(message) &&
-      !std::holds_alternative<proto::RenderTimeSteps>(message))
-    book_.expect(id, synchronous);
+  if (!proto::isRenderRequest(message)) book_.expect(id, synchronous);
   if (!conn_ || !conn_->send(message, id)) {
     book_.pending.erase(id);
     throw TclError({"PVR", "CONNECT", "LOST"}, "session " + name_ + ": the connection is gone");
@@ -113,7 +111,7 @@ std::uint32_t Session::render(const proto::Message& request, std::uint32_t total
     layoutPending_ = false;
   }
   const std::uint32_t id = send(request, false);
-  book_.start(id, label, total, Clock::now());
+  book_.start(id, label, total, Clock::now()).interactive = std::holds_alternative<proto::RenderInteractive>(request);
   return id;
 }
 
