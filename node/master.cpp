@@ -189,6 +189,10 @@ void Master::renderSequence(int count, const std::function<core::CameraSpec(int)
   state_.sendFrame = [&](proto::ImageFrame&& f, bool final) {
     ++framesSent_;
     ++sent;
+    // The snapshot a Status is answered from during the render shows what
+    // the frame's wave loaded (an interactive render's coarse frame is
+    // followed by more rendering, while its client asks).
+    publishStatus();
     send(f, id, final);
   };
   const auto sendCancelled = [&] {
