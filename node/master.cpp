@@ -128,6 +128,15 @@ void Master::on(const proto::RenderFrame&, std::uint32_t id) {
   renderSequence(1, [&](int) { return camera; }, [&](int) { return step; }, id);
 }
 
+// The coarse frame, then the same view at full quality (a wave of its
+// own, which a newer request stops or skips).
+void Master::on(const proto::RenderInteractive& m, std::uint32_t id) {
+  requireDataset(state_);
+  const core::CameraSpec camera = m.turn == 0 ? state_.scene.camera : Rotation(state_.scene.camera, m.rotation()).camera(0);
+  const int step = state_.scene.volumes.front().source.timestep;
+  renderSequence(2, [&](int) { return camera; }, [&](int) { return step; }, id, int(m.reduction));
+}
+
 // A rotation shows the session's time step.
 void Master::on(const proto::RenderRotation& m, std::uint32_t id) {
   const Rotation rotation(state_.scene.camera, m);
@@ -203,7 +212,7 @@ void Master::on(const M&, std::uint32_t id) {
 }
 
 void Master::renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf,
-                            const std::function<int(int)>& stepOf, std::uint32_t id) {
+                            const std::function<int(int)>& stepOf, std::uint32_t id, int coarse) {
   running_ = id;
   publishStatus();
   link_.setRendering(id);
@@ -211,18 +220,29 @@ void Master::renderSequence(int count, const std::function<core::CameraSpec(int)
   state_.sendFrame = [&](proto::ImageFrame&& f, bool final) {
     ++framesSent_;
     ++sent;
+    // The snapshot a Status is answered from during the render shows what
+    // the frame's wave loaded (an interactive render's coarse frame is
+    // followed by more rendering, while its client asks).
+    publishStatus();
     send(f, id, final);
   };
   const auto sendCancelled = [&] {
     send(proto::ErrorMessage{ErrorCode::kCancelled, "cancelled after " + std::to_string(sent) + " frames"}, id);
   };
   // Groups would compute the steps of their frames apart: a computation's
-  // frames go one at a time, to the first group.
+  // frames go one at a time, to the first group; so do a progressive
+  // request's, which gives its later frames up for a newer request.
   const bool computed = computationOf(state_) != nullptr;
-  const int groups = computed ? 1 : state_.layout.groups;
+  const bool progressive = coarse > 1;
+  const int groups = computed || progressive ? 1 : state_.layout.groups;
   for (int first = 0; first < count && link_.open(); first += groups) {
+    if (progressive && first > 0 && link_.giveWayToNewer(id)) {
+      sendCancelled();
+      break;
+    }
     actions::Wave wave;
     wave.request = id;
+    wave.reduction = progressive && first == 0 ? coarse : 1;
     wave.lastFrame = std::uint32_t(count - 1);
     for (int k = first; k < std::min(count, first + groups); ++k)
       wave.frames.push_back({std::uint32_t(k), cameraArgs(cameraOf(k)), stepOf(k)});

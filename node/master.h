@@ -44,6 +44,7 @@ class Master {
   void on(const proto::RenderRotation& m, std::uint32_t id);
   void on(const proto::RenderTimeSteps& m, std::uint32_t id);
   void on(const proto::RenderSteps& m, std::uint32_t id);
+  void on(const proto::RenderInteractive& m, std::uint32_t id);
   void on(const proto::PerformanceRequest& m, std::uint32_t id);
   void on(const proto::Cancel& m, std::uint32_t id);
   void on(const proto::Close& m, std::uint32_t id);
@@ -59,9 +60,12 @@ class Master {
   // go out in order, the last FINAL. Each wave names the steps of the
   // frames after it, for the render ranks to read ahead. A computation
   // volume is computed, not read: one frame per wave, and the session's
-  // step follows the frames (showComputedStep).
+  // step follows the frames (showComputedStep). `coarse` > 1:
+  // progressively (proto::RenderInteractive), one frame per wave, frame 0
+  // at 1/coarse of the pixels per axis, and every later frame given up
+  // for a newer request (LinkThread::giveWayToNewer).
   void renderSequence(int count, const std::function<core::CameraSpec(int)>& cameraOf,
-                      const std::function<int(int)>& stepOf, std::uint32_t id);
+                      const std::function<int(int)>& stepOf, std::uint32_t id, int coarse = 1);
 
   // A computation volume: the session's time step becomes `step`, the one
   // the ranks compute up to (docs/steering.md); the wave that computes it

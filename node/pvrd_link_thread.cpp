@@ -24,6 +24,13 @@ constexpr std::size_t kLinkBytes = std::size_t(4) << 20;
 // How long a closing link may take to hand the client what is queued.
 constexpr auto kCloseGrace = std::chrono::seconds(5);
 
+// A request that asks the master for work, which an interactive render's
+// full-quality frame gives way to (giveWayToNewer); queries do not.
+bool asksForWork(const proto::Message& m) {
+  return !std::holds_alternative<proto::StatusRequest>(m) && !std::holds_alternative<proto::PerformanceRequest>(m) &&
+         !std::holds_alternative<proto::CatalogRequest>(m);
+}
+
 std::vector<std::uint8_t> encodeFinal(const proto::Message& m, std::uint32_t id, bool final = true) {
   return proto::encode(m, id, final ? proto::kFlagFinal : 0);
 }
@@ -96,6 +103,15 @@ void LinkThread::send(const proto::Message& m, std::uint32_t id, bool final) {
 void LinkThread::setRendering(std::uint32_t id) {
   const std::lock_guard lock(mutex_);
   rendering_ = id;
+  givesWay_ = 0;
+}
+
+bool LinkThread::giveWayToNewer(std::uint32_t id) {
+  const std::lock_guard lock(mutex_);
+  if (std::any_of(requests_.begin(), requests_.end(), [](const proto::Decoded& d) { return asksForWork(d.message); }))
+    return true;
+  givesWay_ = id;
+  return false;
 }
 
 void LinkThread::publishStatus(proto::StatusReply status) {
@@ -180,8 +196,10 @@ void LinkThread::dispatch(proto::Decoded frame) {
                         id));
     return;
   }
+  const bool newer = asksForWork(frame.message);
   requests_.push_back(std::move(frame));
   changed_.notify_all();
+  if (newer && givesWay_ != 0 && givesWay_ == current_) stopCurrent();
 }
 
 void LinkThread::run() {

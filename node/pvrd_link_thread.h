@@ -13,6 +13,8 @@
 //     the ray casters check between tiles (onCancel, rank_watch.h); of a
 //     request still queued, it takes it off the queue and answers it with
 //     Error CANCELLED;
+//   - stops the render in progress when it gives way to newer requests
+//     (giveWayToNewer) and one arrives, as a Cancel would;
 //   - queues every other request for the main thread, in order, at most
 //     kMaxQueuedRequests of them (LIMIT_EXCEEDED beyond: a flood grew rank
 //     0 by 1.76 GiB in 18 s before);
@@ -67,6 +69,13 @@ class LinkThread {
   // is answered from `status` at once and Cancel stops it.
   void setRendering(std::uint32_t id);
   void publishStatus(proto::StatusReply status);
+  // Main thread, for the render `id` in progress (an interactive render
+  // about to draw its full-quality frame): from now until it ends, a newer
+  // request that asks for work (anything but Status, Performance and
+  // Catalog requests) stops it as a Cancel would. True when such a
+  // request is queued already; then nothing is stopped, the caller ends
+  // the render itself.
+  bool giveWayToNewer(std::uint32_t id);
   // True once a Cancel named the render `id` in progress.
   bool cancelled(std::uint32_t id) const { return id != 0 && cancelled_.load() == id; }
   // Sends what is queued, then closes the link (the client's Close, or a
@@ -102,6 +111,7 @@ class LinkThread {
   std::uint32_t current_ = 0;    // the request the main thread took last
   bool currentIsRender_ = false;
   std::uint32_t rendering_ = 0;  // the render in progress; 0: none
+  std::uint32_t givesWay_ = 0;   // the render a newer request stops (giveWayToNewer); 0: none
   proto::StatusReply status_;
   bool closing_ = false;
   std::atomic<std::uint32_t> cancelled_{0};

@@ -60,9 +60,18 @@ std::optional<ProtocolError> RenderSteps::check(const Limits& limits) const {
   return std::nullopt;
 }
 
+std::optional<ProtocolError> RenderInteractive::check(const Limits& limits) const {
+  if (reduction < 2 || reduction > kMaxInteractiveReduction)
+    return ProtocolError{ErrorCode::kBadArgument, "interactive render with reduction " + std::to_string(reduction) +
+                                                      "; it must be 2 to " +
+                                                      std::to_string(kMaxInteractiveReduction) + " pixels per axis"};
+  return rotation().check(limits);
+}
+
 bool isRenderRequest(const Message& m) {
   return std::holds_alternative<RenderFrame>(m) || std::holds_alternative<RenderRotation>(m) ||
-         std::holds_alternative<RenderTimeSteps>(m) || std::holds_alternative<RenderSteps>(m);
+         std::holds_alternative<RenderTimeSteps>(m) || std::holds_alternative<RenderSteps>(m) ||
+         std::holds_alternative<RenderInteractive>(m);
 }
 
 std::optional<ProtocolError> ImageFrame::checkHead(std::uint64_t pixelBytes, const Limits& limits) const {

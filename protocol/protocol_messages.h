@@ -309,6 +309,32 @@ struct RenderSteps {
   bool operator==(const RenderSteps&) const = default;
 };
 
+// Client -> server: one frame of the current view, progressively (a view
+// that is being dragged): first a coarse frame, 1/reduction of the pixels
+// per axis upscaled to the image size (ImageFrame 0, not FINAL), then the
+// full-quality frame (ImageFrame 1, FINAL) unless a newer request arrived
+// meanwhile, which ends this one with Error CANCELLED. The view is the
+// session's camera turned by 360 degrees * turn / stepsPerTurn about `axis`
+// through its look-at point, as frame `turn` of a RenderRotation (turn 0:
+// the camera as it is). Older servers do not know the type: a client falls
+// back to RenderFrame or RenderRotation.
+inline constexpr std::uint32_t kMaxInteractiveReduction = 16;
+
+struct RenderInteractive {
+  static constexpr WireInfo kWire{0x26, "RenderInteractive", &Limits::maxControlPayload};
+  std::uint32_t reduction = 4;  // 2 .. kMaxInteractiveReduction
+  std::array<double, 3> axis{0, 0, 1};
+  std::int32_t turn = 0;
+  std::uint32_t stepsPerTurn = 1;
+  static auto fields(auto& self) { return std::tie(self.reduction, self.axis, self.turn, self.stepsPerTurn); }
+  // reduction in 2 .. kMaxInteractiveReduction, and the view's turn passes
+  // RenderRotation::check as a one-frame rotation; kBadArgument otherwise.
+  std::optional<ProtocolError> check(const Limits& limits) const;
+  // The view as the one-frame rotation it is.
+  RenderRotation rotation() const { return RenderRotation{axis, turn, turn, stepsPerTurn}; }
+  bool operator==(const RenderInteractive&) const = default;
+};
+
 // Server -> client: one rendered frame.
 struct ImageFrame {
   static constexpr WireInfo kWire{0x22, "ImageFrame", &Limits::maxFrameBytes};
@@ -397,11 +423,12 @@ struct CatalogReply {
 using Message = std::variant<
     Hello, Welcome, AuthChallenge, AuthResponse, Ok, ErrorMessage, Close, JobHello,
     SessionOpen, SessionReady, SetScene, SetLayout,
-    RenderFrame, RenderRotation, RenderTimeSteps, RenderSteps, ImageFrame, Cancel,
+    RenderFrame, RenderRotation, RenderTimeSteps, RenderSteps, RenderInteractive, ImageFrame, Cancel,
     StatusRequest, StatusReply, PerformanceRequest, PerformanceReply, CatalogRequest, CatalogReply, Heartbeat>;
 
 // Whether `m` asks for frames (RenderFrame, RenderRotation, RenderTimeSteps,
-// RenderSteps): a sequence whose answers are frames, the last FINAL.
+// RenderSteps, RenderInteractive): a sequence whose answers are frames, the
+// last FINAL, which may stream for a long time.
 bool isRenderRequest(const Message& m);
 
 }  // namespace pvr::proto

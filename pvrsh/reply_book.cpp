@@ -59,6 +59,7 @@ Arrival ReplyBook::route(const proto::Decoded& d, Clock::time_point now) {
       r.arrival = seconds(now - seq.sent);
       r.width = int(f->width);
       r.height = int(f->height);
+      r.coarse = seq.interactive && f->frameNumber == 0;
       seq.frames.push_back(r);
       a.kind = Arrival::Kind::kFrame;
       a.frame = f;

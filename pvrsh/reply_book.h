@@ -42,6 +42,7 @@ struct FrameRecord {
   proto::FrameTiming timing;
   double arrival = 0;  // seconds since the request was sent
   int width = 0, height = 0;
+  bool coarse = false;  // the coarse frame of an interactive render (proto::RenderInteractive)
 };
 
 // A render request in flight: RenderFrame, RenderRotation or RenderTimeSteps.
@@ -52,6 +53,7 @@ struct Sequence {
   Clock::time_point sent;
   std::vector<FrameRecord> frames;
   bool cancelled = false;    // ended early (cancel, or a frame pvrsh could not deliver)
+  bool interactive = false;  // RenderInteractive: frame 0 is coarse, frame 1 full
 };
 
 // A request whose answer someone waits for (open, queries) or that only

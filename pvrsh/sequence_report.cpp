@@ -47,6 +47,7 @@ Tcl_Obj* timingDict(const FrameRecord& r) {
   put("arrival", r.arrival);
   Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj("width", -1), Tcl_NewIntObj(r.width));
   Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj("height", -1), Tcl_NewIntObj(r.height));
+  Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj("quality", -1), Tcl_NewStringObj(r.coarse ? "coarse" : "full", -1));
   return d;
 }
 

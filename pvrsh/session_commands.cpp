@@ -320,8 +320,32 @@ int renderSteps(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[])
   return TCL_OK;
 }
 
-// :s render rotate|rotation X,Y,Z S,E:N  |  :s render time S,E?:STRIDE?  |  :s render frame
-// |  :s render steps N ?-every K?
+// The options after `render frame` and `render rotate AXIS K,K:N`:
+// ?-interactive? ?-reduction R?. The reduction of the coarse frame when
+// the render is interactive (default 4), else nothing; `wrong` set for a
+// word that is neither.
+std::optional<std::uint32_t> parseInteractive(int objc, Tcl_Obj* const objv[], int first, bool& wrong) {
+  wrong = false;
+  bool interactive = false;
+  std::uint32_t reduction = 4;
+  for (int i = first; i < objc; ++i) {
+    const std::string option = str(objv[i]);
+    if (option == "-interactive") {
+      interactive = true;
+    } else if (option == "-reduction" && i + 1 < objc) {
+      reduction = std::uint32_t(parseInteger("-reduction", str(objv[++i]), 2, proto::kMaxInteractiveReduction));
+      interactive = true;
+    } else {
+      wrong = true;
+      return std::nullopt;
+    }
+  }
+  if (!interactive) return std::nullopt;
+  return reduction;
+}
+
+// :s render rotate|rotation X,Y,Z S,E:N ?-interactive? ?-reduction R?  |  :s render time S,E?:STRIDE?  |
+// :s render frame ?-interactive? ?-reduction R?  |  :s render steps N ?-every K?
 int renderCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   static const char* const kKinds[] = {"frame", "rotate", "rotation", "time", "steps", nullptr};
   if (objc < 3) {
@@ -344,16 +368,26 @@ int renderCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
     return TCL_OK;
   }
   if (kind == 0) {
-    if (objc != 3) {
-      Tcl_WrongNumArgs(interp, 3, objv, nullptr);
+    // An interactive frame: the coarse frame, then the full one.
+    bool wrong = false;
+    const auto reduction = parseInteractive(objc, objv, 3, wrong);
+    if (wrong) {
+      Tcl_WrongNumArgs(interp, 3, objv, "?-interactive? ?-reduction R?");
       return TCL_ERROR;
+    }
+    if (reduction) {
+      s.render(proto::RenderInteractive{*reduction, {0, 0, 1}, 0, 1}, 2, "frame -interactive");
+      Tcl_SetObjResult(interp, Tcl_NewIntObj(2));
+      return TCL_OK;
     }
     s.render(proto::RenderFrame{}, 1, "frame");
     Tcl_SetObjResult(interp, Tcl_NewIntObj(1));
     return TCL_OK;
   }
-  if (objc != 5) {
-    Tcl_WrongNumArgs(interp, 3, objv, "axis start,end:steps");
+  bool wrong = false;
+  const auto reduction = objc < 5 ? std::nullopt : parseInteractive(objc, objv, 5, wrong);
+  if (objc < 5 || wrong) {
+    Tcl_WrongNumArgs(interp, 3, objv, "axis start,end:steps ?-interactive? ?-reduction R?");
     return TCL_ERROR;
   }
   const std::string axisText = str(objv[3]), range = str(objv[4]);
@@ -368,6 +402,13 @@ int renderCmd(Session& s, Tcl_Interp* interp, int objc, Tcl_Obj* const objv[]) {
   r.end = std::int32_t(parseInteger("-end", range.substr(comma + 1, colon - comma - 1), INT32_MIN, INT32_MAX));
   r.stepsPerTurn = std::uint32_t(parseInteger("-steps", range.substr(colon + 1), 0, UINT32_MAX));
   checkRotation(r);
+  if (reduction) {
+    if (r.start != r.end) argsError("RANGE", "render rotate -interactive: one view only, K,K:N; got '" + range + "'");
+    s.render(proto::RenderInteractive{*reduction, r.axis, r.start, r.stepsPerTurn}, 2,
+             "rotate " + axisText + " " + range + " -interactive");
+    Tcl_SetObjResult(interp, Tcl_NewIntObj(2));
+    return TCL_OK;
+  }
   const std::uint32_t frames = r.frameCount();
   s.render(r, frames, "rotate " + axisText + " " + range);
   Tcl_SetObjResult(interp, Tcl_NewWideIntObj(frames));
@@ -496,7 +537,8 @@ const Subcommand kSubcommands[] = {
     {"performance", performanceCmd,
      "memory ?cluster? ?index? | comp ?cluster? ?latency? ?index? | cache ?cluster? ?index?",
      "memory, compositing or cache figures of the clusters"},
-    {"render", renderCmd, "rotate axis start,end:steps | time start,end?:stride? | steps n ?-every k? | frame",
+    {"render", renderCmd,
+     "rotate axis start,end:steps ?-interactive? | time start,end?:stride? | steps n ?-every k? | frame ?-interactive?",
      "render one frame, a rotation, time steps, or a computation's next n steps (a frame every k-th and of the "
      "last); returns the number of frames"},
     {"set", setCmd, "option ?value option value ...?",

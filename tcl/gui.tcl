@@ -336,7 +336,7 @@ proc ::pvr::gui::checkConnection {} {
     catch {set state [dict get [$session list status] state]}
     if {$state ne "open"} {
         markConnected 0
-        ::pvr::gui::view::finished
+        ::pvr::gui::view::finished all
         status "the session ended (state $state): press Connect to start a new one" error
     }
 }
@@ -345,7 +345,7 @@ proc ::pvr::gui::disconnect {} {
     variable session
     catch {$session close}
     markConnected 0
-    ::pvr::gui::view::finished
+    ::pvr::gui::view::finished all
     status "disconnected"
 }
 
@@ -614,10 +614,12 @@ proc ::pvr::gui::send {args} {
 }
 
 # ::pvr::gui::requestFrame --
-#   A frame of the current view (::pvr::gui::view::request); a failure is
-#   a message on the status line. Results: 1 when sent or queued.
-proc ::pvr::gui::requestFrame {} {
-    if {[catch {::pvr::gui::view::request} message]} {
+#   A frame of the current view (::pvr::gui::view::request): progressive
+#   (a coarse frame, then the full one) or `full` (one frame, for saving);
+#   a failure is a message on the status line. Results: 1 when sent or
+#   queued.
+proc ::pvr::gui::requestFrame {{quality progressive}} {
+    if {[catch {::pvr::gui::view::request [expr {$quality eq "progressive"}]} message]} {
         status "render: $message" error
         return 0
     }
@@ -687,6 +689,13 @@ proc ::pvr::gui::onFrame {frame timing} {
     dict set request last $now
     dict set timing arrival [expr {($now - $since) / 1e6}]
     ::pvr::gui::stat::add .stat.c $frame $timing
+    # An interactive render's coarse frame: the next view may go out.
+    # lastQuality and coarseFrames are for the status of tests.
+    variable lastQuality [dict get $timing quality]
+    if {$lastQuality eq "coarse"} {
+        incr ::pvr::gui::coarseFrames
+        ::pvr::gui::view::firstFrame
+    }
     if {[dict get $request kind] eq "sequence"} {
         set ::pvr::gui::progress $done
         set fps [expr {$elapsed > 0 ? $done / $elapsed : 0}]

@@ -187,7 +187,8 @@ proc ::pvr::gui::render::saveImage {file} {
         return 0
     }
     set numbered $stem-*.png
-    ::pvr::gui::requestFrame
+    # One frame, at full quality: not an interactive render's two.
+    ::pvr::gui::requestFrame full
     return 1
 }
 

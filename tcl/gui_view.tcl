@@ -24,9 +24,16 @@
 # camera becomes the orbit's base: so the server's camera is the view on
 # screen, and a sequence starts from it.
 #
-# Coalescing: at most one request is in flight. A drag that moves while a
-# frame is being rendered only records the newest angles; when the frame
-# arrives (or fails) the newest angles are sent, once.
+# Coalescing: at most one request waits for its first frame. A drag that
+# moves meanwhile only records the newest angles; when the frame arrives
+# (or the request fails) the newest angles are sent, once.
+#
+# Progressive refinement: the requests are interactive renders (`render
+# ... -interactive`, docs/pvrsh.md): a coarse frame comes first, and the
+# full-quality frame follows unless the view moved on. The next view goes
+# out as soon as the coarse frame arrives (firstFrame), superseding the
+# full one, so a drag shows coarse frames at the coarse rate and, when it
+# stops, the full frame of where it stopped.
 
 namespace eval ::pvr::gui::view {
     # The reported camera as the orbit's basis: unit vectors up (the
@@ -195,6 +202,10 @@ namespace eval ::pvr::gui::view {
     variable elevation 0.0
     variable busy 0
     variable dirty 0
+    # Requests sent whose end (done or cancelled) has not come yet, and
+    # whether requests are interactive renders.
+    variable pending 0
+    variable interactive 1
     variable drag {}
     # The command prefix that sends one render request; it gets the words
     # after `render` ("frame" or "rotate AXIS K,K:N") appended.
@@ -369,7 +380,7 @@ proc ::pvr::gui::view::sceneChanged {} {
 # ::pvr::gui::view::request --
 #   Sends a frame of the current view now, or records that one is wanted
 #   when a request is in flight.
-proc ::pvr::gui::view::request {} {
+proc ::pvr::gui::view::request {{progressive 1}} {
     variable busy
     variable dirty
     variable sender
@@ -408,20 +419,50 @@ proc ::pvr::gui::view::request {} {
         }
         set rotate [rotateArgs $azimuth $elevation]
         set words [expr {$rotate eq {} ? {frame} : [linsert $rotate 0 rotate]}]
+        variable interactive
+        if {$interactive && $progressive} {
+            lappend words -interactive
+        }
         uplevel #0 [concat $sender $words]
     } message options]} {
         set busy 0
         return -options $options $message
     }
     incr sent
+    variable pending
+    incr pending
 }
 
 # ::pvr::gui::view::finished --
 #   The request in flight is over (its frame arrived, or it failed, or was
-#   cancelled); sends the newest view if it changed meanwhile.
-proc ::pvr::gui::view::finished {} {
+#   cancelled; `all`: every request, the session ended); sends the newest
+#   view if it changed meanwhile and no request waits for its first frame.
+proc ::pvr::gui::view::finished {{all ""}} {
     variable busy
     variable dirty
+    variable pending
+    set pending [expr {$all eq "all" ? 0 : max(0, $pending - 1)}]
+    if {$pending == 0} {
+        set busy 0
+    }
+    if {$dirty && !$busy} {
+        request
+    }
+}
+
+# ::pvr::gui::view::firstFrame --
+#   The coarse frame of the request in flight arrived: the newest view, if
+#   it changed meanwhile by orbiting, goes out now and supersedes the full
+#   frame. Camera moves wait for the request to end (finished): they read
+#   the server's camera back, which pvrsh answers only between renders.
+proc ::pvr::gui::view::firstFrame {} {
+    variable busy
+    variable dirty
+    variable moves
+    variable base
+    if {$moves ne {} || $base eq {}} {
+        return
+    }
     set busy 0
     if {$dirty} {
         request

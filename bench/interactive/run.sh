@@ -7,12 +7,14 @@
 #
 #   bench/interactive/run.sh [BUILD_DIR]    (default: build)
 # Environment: PVR_BENCH_FRAMES (50), PVR_BENCH_RANKS (2), PVR_BENCH_SHADING (1),
-# PVR_BENCH_NAME (latency).
+# PVR_BENCH_NAME (latency), PVR_BENCH_INTERACTIVE (0; 1: progressive renders,
+# reporting request-to-first-pixels and request-to-full-quality),
+# PVR_BENCH_REDUCTION (4: the coarse frame's pixels per axis).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 build=$(cd "${1:-$root/build}" && pwd)
-data=$(cd "$root/../shared/data" && pwd)
+data=$(cd "${PVR_BENCH_DATA:-$root/../shared/data}" && pwd)  # a worktree elsewhere: PVR_BENCH_DATA
 out=$root/bench/results/interactive
 for exe in pvrsh/pvrsh pvrd/pvrd pvrd/pvr-node; do
   [ -x "$build/$exe" ] || { echo "run.sh: build $build/$exe first (cmake --build $build --target pvrsh pvrd pvr-node)" >&2; exit 1; }
@@ -37,4 +39,5 @@ run=()
 "${run[@]}" "$build/pvrsh/pvrsh" "$here/latency.tcl" -host "127.0.0.1:$port" \
   -frames "${PVR_BENCH_FRAMES:-50}" -ranks "${PVR_BENCH_RANKS:-2}" -shading "${PVR_BENCH_SHADING:-1}" \
   -preset "$root/examples/presets/ct_bone.json" -out "$out" -tag "${PVR_BENCH_NAME:-latency}" \
+  -interactive "${PVR_BENCH_INTERACTIVE:-0}" -reduction "${PVR_BENCH_REDUCTION:-4}" \
   | tee "$out/${PVR_BENCH_NAME:-latency}.txt"

@@ -62,7 +62,12 @@ struct Wave {
   // frame j of the list goes to group j % groups, whose render ranks read
   // it ahead (brick_cache.h).
   std::vector<std::int32_t> upcoming;
-  static auto fields(auto& self) { return std::tie(self.request, self.frames, self.lastFrame, self.upcoming); }
+  // 1, or an interactive render's coarse wave: its frames are rendered at
+  // 1/reduction of the pixels per axis and sent upscaled (coarse_frame.h).
+  std::int32_t reduction = 1;
+  static auto fields(auto& self) {
+    return std::tie(self.request, self.frames, self.lastFrame, self.upcoming, self.reduction);
+  }
   static void run(NodeState& state, const Wave& args);
 };
 

@@ -15,6 +15,7 @@
 
 #include "../cache_cluster.h"
 #include "../computation_data.h"
+#include "../coarse_frame.h"
 #include "../data.h"
 #include "../rank_watch.h"
 #include "../wave_collect.h"
@@ -96,6 +97,8 @@ void Wave::run(NodeState& state, const Wave& args) {
   // the last, as the master's does (Master::showComputedStep).
   if (computationOf(state) && !args.frames.empty())
     state.scene.volumes.front().source.timestep = args.frames.back().timestep;
+  // Every step of a coarse wave works at the reduced size.
+  const ReducedImage reduced(state.scene.image, std::max<std::int32_t>(1, args.reduction));
   std::optional<comm::Failure> failure;
   {
     const comm::LivenessScope loading(state.liveness, comm::LivenessScope::Kind::kLoading);
@@ -103,7 +106,7 @@ void Wave::run(NodeState& state, const Wave& args) {
   }
   renderMyFrame(state, args, failure);
   compositeWave(state, failure);
-  collectWave(state, args.request, args.lastFrame, failure);
+  collectWave(state, args.request, args.lastFrame, reduced.full(), failure);
   if (failure) throw comm::FailureError(*failure);
 }
 

@@ -31,6 +31,7 @@
 #include <thread>
 
 #include "camera.h"
+#include "coarse_frame.h"
 #include "computation_run.h"
 #include "frame_pixels.h"
 #include "in_process_communicator.h"
@@ -217,6 +218,17 @@ class Job {
     REQUIRE_FALSE(channel_->send(proto::encode(m, ++id_, proto::kFlagFinal)));
     flush();
     return id_;
+  }
+  // Sends `messages` in one write, so that the master's link reads them
+  // together; their request ids.
+  std::vector<std::uint32_t> sendTogether(const std::vector<proto::Message>& messages) {
+    std::vector<std::uint32_t> ids;
+    for (const auto& m : messages) {
+      REQUIRE_FALSE(channel_->send(proto::encode(m, ++id_, proto::kFlagFinal)));
+      ids.push_back(id_);
+    }
+    flush();
+    return ids;
   }
   // True when a connection came to the handler's socket within `seconds`.
   bool connected(int seconds) {
@@ -1309,5 +1321,91 @@ TEST_CASE_METHOD(Fixture, "render steps on a dataset, and parameters for it, are
   SerialComputation serial;
   const auto id = job.send(proto::RenderSteps{1, 1});
   checkComputedFrames(job, id, serial, {step + 1});
+  CHECK(job.close());
+}
+
+// ---- Progressive refinement (issue 13, point 4): an interactive request
+// is answered by a coarse frame, then the full-quality one, unless a newer
+// request came meanwhile.
+
+TEST_CASE_METHOD(Fixture, "an interactive request sends a coarse frame, then the full frame a normal render sends") {
+  Job job(2);
+  job.send(proto::SessionOpen{2, {}, ""});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  const Reference ref(nlohmann::json::object());
+  // The coarse frame: the view rendered at 1/4 of the pixels per axis
+  // (16 x 16), upscaled to the session's 64 x 64.
+  const Reference coarse(nlohmann::json::parse(R"({"image": {"width": 16, "height": 16}})"));
+  for (const std::int32_t turn : {0, 5}) {
+    INFO("turn " << turn);
+    const auto id = job.send(proto::RenderInteractive{4, {0, 1, 0}, turn, 60});
+    auto first = job.receive();
+    REQUIRE(first);
+    if (const auto* e = std::get_if<proto::ErrorMessage>(&first->message)) FAIL(e->text);
+    const auto quick = std::get<proto::ImageFrame>(first->message);
+    CHECK(first->info.requestId == id);
+    CHECK_FALSE(first->info.final());
+    CHECK(quick.frameNumber == 0);
+    CHECK(quick.width == 64);
+    CHECK(quick.height == 64);
+    CHECK(core::maxAbsDifference(dumped(job, id, 0), node::upscaleFrame(coarse.frame(turn, 60), 64, 64)) <= 1e-5);
+    auto second = job.receive();
+    REQUIRE(second);
+    if (const auto* e = std::get_if<proto::ErrorMessage>(&second->message)) FAIL(e->text);
+    const auto full = std::get<proto::ImageFrame>(second->message);
+    CHECK(second->info.requestId == id);
+    CHECK(second->info.final());
+    CHECK(full.frameNumber == 1);
+    CHECK(core::maxAbsDifference(dumped(job, id, 1), ref.frame(turn, 60)) <= 1e-5);
+    CHECK(quick.pixels != full.pixels);
+    // The same view rendered normally: the very bytes of the full frame.
+    if (turn == 0) job.send(proto::RenderFrame{});
+    else job.send(proto::RenderRotation{{0, 1, 0}, turn, turn, 60});
+    const auto normal = job.expect<proto::ImageFrame>();
+    CHECK(normal.pixels == full.pixels);
+  }
+  CHECK(job.close());
+}
+
+TEST_CASE_METHOD(Fixture, "a newer request cancels an interactive render's full frame, rendering or waiting") {
+  Job job(2);
+  openSlowSession(job, 2);
+  // While the slow full frame renders, a scene change arrives: the render
+  // stops after its coarse frame.
+  const auto slow = job.send(proto::RenderInteractive{4, {0, 1, 0}, 0, 1});
+  const auto quick = job.expect<proto::ImageFrame>();
+  CHECK(quick.frameNumber == 0);
+  const auto change = job.send(proto::SetScene{"", R"({"sampling": null, "image": {"width": 64, "height": 64}})"});
+  auto ended = job.receive(120);
+  REQUIRE(ended);
+  CHECK(ended->info.requestId == slow);
+  REQUIRE(std::holds_alternative<proto::ErrorMessage>(ended->message));
+  CHECK(std::get<proto::ErrorMessage>(ended->message).code == proto::ErrorCode::kCancelled);
+  CHECK(std::get<proto::ErrorMessage>(ended->message).text == "cancelled after 1 frames");
+  auto ok = job.receive();
+  REQUIRE(ok);
+  CHECK(ok->info.requestId == change);
+  CHECK(std::holds_alternative<proto::Ok>(ok->message));
+  // Two views one after the other: the first is queued behind when its
+  // coarse frame is done, so its full frame is never rendered; the second
+  // refines.
+  const auto ids = job.sendTogether({proto::RenderInteractive{4, {0, 1, 0}, 3, 60}, proto::RenderInteractive{4, {0, 1, 0}, 4, 60}});
+  const std::uint32_t older = ids[0], newer = ids[1];
+  std::vector<std::pair<std::uint32_t, std::string>> answers;
+  for (int i = 0; i < 4; ++i) {
+    auto d = job.receive(120);
+    REQUIRE(d);
+    if (const auto* f = std::get_if<proto::ImageFrame>(&d->message))
+      answers.emplace_back(d->info.requestId, "frame " + std::to_string(f->frameNumber));
+    else if (const auto* e = std::get_if<proto::ErrorMessage>(&d->message))
+      answers.emplace_back(d->info.requestId, e->text);
+  }
+  const std::vector<std::pair<std::uint32_t, std::string>> expected{
+      {older, "frame 0"}, {older, "cancelled after 1 frames"}, {newer, "frame 0"}, {newer, "frame 1"}};
+  CHECK(answers == expected);
+  CHECK(core::maxAbsDifference(dumped(job, newer, 1), Reference(nlohmann::json::object()).frame(4, 60)) <= 1e-5);
+  CHECK_FALSE(fs::exists(job.dumpDir() / ("frame-" + std::to_string(older) + "-1.f32")));
   CHECK(job.close());
 }

@@ -154,6 +154,11 @@ std::vector<HostileCase> hostileCases() {
        ErrorCode::kLimitExceeded, "limit of " + std::to_string(kMaxRotationFrames) + " frames"},
       {"rotation about the zero axis", encode(RenderRotation{{0, 0, 0}, 0, 1, 60}, 1), ErrorCode::kBadArgument,
        "not a finite nonzero vector"},
+      // Interactive requests (RenderInteractive::check).
+      {"interactive render without reduction", encode(RenderInteractive{1, {0, 0, 1}, 0, 1}, 1),
+       ErrorCode::kBadArgument, "reduction 1"},
+      {"interactive render turning about a zero axis", encode(RenderInteractive{4, {0, 0, 0}, 3, 60}, 1),
+       ErrorCode::kBadArgument, "not a finite nonzero vector"},
       // Time-step requests (RenderTimeSteps::check).
       {"time steps with stride 0", encode(RenderTimeSteps{0, 9, 0}, 1), ErrorCode::kBadArgument, "stride 0"},
       {"time steps ending before they start", encode(RenderTimeSteps{5, 4, 1}, 1), ErrorCode::kBadArgument,

@@ -49,6 +49,7 @@ std::vector<Message> sampleMessages() {
       RenderRotation{{0, 1, 0}, 15, 59, 60},
       RenderTimeSteps{0, 48, 2},
       RenderSteps{96, 4},
+      RenderInteractive{4, {0, 1, 0}, 15, 60},
       sampleImage(),
       Cancel{42},
       StatusRequest{},

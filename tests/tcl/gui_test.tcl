@@ -156,7 +156,7 @@ update
 
 # idle: no request in flight and none waiting.
 proc idle {} {
-    return [expr {!$::pvr::gui::view::busy && !$::pvr::gui::view::dirty}]
+    return [expr {!$::pvr::gui::view::busy && !$::pvr::gui::view::dirty && $::pvr::gui::view::pending == 0}]
 }
 # lit: pixels of the photo brighter than the dark background, in a 16x16 grid.
 proc lit {} {
@@ -216,6 +216,7 @@ check "editor: the histogram's bars are drawn" {[llength [.ctl.tf.editor find wi
 
 # ---- Step 3: a drag on the image ----
 set sentBefore $::pvr::gui::view::sent
+set coarseBefore [expr {[info exists ::pvr::gui::coarseFrames] ? $::pvr::gui::coarseFrames : 0}]
 set az0 $::pvr::gui::view::azimuth
 set el0 $::pvr::gui::view::elevation
 set img .view.image
@@ -233,6 +234,11 @@ set requests [expr {$::pvr::gui::view::sent - $sentBefore}]
 check "drag: 12 motion events coalesced into fewer requests" {$requests >= 1 && $requests < 12} "requests $requests"
 set frame1 [pixels]
 check "drag: the image changed" {$frame1 ne $frame0}
+# Progressive refinement: the drag's requests were interactive renders,
+# each showing a coarse frame first; the last view ends at full quality.
+check "drag: coarse frames while dragging, the full-quality frame last" \
+    {$::pvr::gui::coarseFrames > $coarseBefore && $::pvr::gui::lastQuality eq "full"} \
+    "coarse [expr {$::pvr::gui::coarseFrames - $coarseBefore}], last $::pvr::gui::lastQuality"
 check "drag: the volume is still visible" {[lit] > 5} "lit [lit]"
 
 # ---- Step 4: the turn-right button ----
