@@ -49,7 +49,7 @@ SceneBricks distributeScene(const std::vector<const core::VolumeSource*>& source
   SceneBricks out;
   comm::runAgreed(comm, [&] {
     for (const core::VolumeSource* s : sources) out.grids.push_back(s->grid());
-    out.tree = core::KdTree::build(core::unionGrid(out.grids), comm.size(), kSplitAxisRule);
+    out.tree = core::KdTree::build(core::unionGrid(out.grids), comm.size(), splitAxisRule(Decomposition::kKd));
     out.region = core::regionOf(out.tree, comm.rank());
   });
   // Each volume in turn, so rank 0 holds at most one whole volume while scattering.

@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include "catalog_listing.h"
 #include "io/data_directory.h"
 #include "io/volume_io.h"
 #include "scene.h"
@@ -67,7 +68,12 @@ std::optional<ProtocolError> resolveEntryDataset(nlohmann::json& entry, const st
   if (!dataset->is_string())
     return ProtocolError{ErrorCode::kBadArgument, where + ".dataset: must be a dataset name (a string)"};
   const std::string name = dataset->get<std::string>();
-  const auto file = resolveDataset(name, dataDir);
+  auto file = resolveDataset(name, dataDir);
+  // A catalog stem ("head" for head.nhdr), as `list datasets` names it and
+  // pvrd resolves SetScene's dataset field (pvrd/dataset_names.h).
+  if (!file && !dataDir.empty())
+    for (const CatalogDataset& d : listCatalog(dataDir).datasets)
+      if (d.name == name) file = resolveDataset(d.file, dataDir);
   if (!file)
     return ProtocolError{ErrorCode::kDatasetNotFound, where + ".dataset: no dataset '" + name + "' in the data directory"};
   entry.erase("dataset");

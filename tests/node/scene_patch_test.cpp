@@ -170,6 +170,9 @@ TEST_CASE("a volumes list replaces the session's volumes, its datasets resolved 
   CHECK_FALSE(two.doc["volumes"][0].contains("dataset"));
   CHECK(two.doc["volumes"][0]["visible"] == false);
   CHECK(two.doc["volumes"][1]["procedural"] == "marschner-lobb");
+  // By catalog stem, as `list datasets` names it (and pvrd the dataset field).
+  const SessionScene stem = accepted(one, {"", R"({"volumes": [{"name": "ct", "dataset": "ct"}]})"});
+  CHECK(stem.doc["volumes"][0]["file"] == dataDir() + "/ct.json");
 
   auto e = refused(one, {"", R"({"volumes": [{"name": "a", "file": "/etc/passwd"}]})"});
   CHECK(e.code == proto::ErrorCode::kBadArgument);

@@ -1183,6 +1183,9 @@ TEST_CASE_METHOD(Fixture, "new ghost layers are read with a compositing cluster 
   job.expect<proto::Ok>();
   id = job.send(proto::RenderFrame{});
   checkSequence(job, id, 1, 1, Reference(nlohmann::json::parse(R"({"shading": {"enabled": false}})")));
+  CHECK(job.close());
+}
+
 // ---- Steering: a computation volume (docs/steering.md) ----
 
 namespace {
