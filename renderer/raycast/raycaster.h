@@ -44,7 +44,7 @@ RenderOptions renderOptionsFor(const Scene& resolvedScene);
 // Ghost layers a brick needs beyond its owned box for these options:
 // trilinear sampling needs none (neighbours share the face nodes), central
 // differences one, a pre-integrated segment reads two steps beyond (its
-// back node's curvature correction) and is lit half a step beyond, one
+// back node's curvature correction) and is lit up to a step beyond, one
 // more for its central differences.
 int ghostLayers(const GridGeometry& grid, const RenderOptions& options);
 
