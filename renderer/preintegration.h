@@ -32,6 +32,7 @@ struct PreintegralNode {
   double tau;     // extinction at the node; 0 where the node is opaque
   double k[3];    // c tau, linear colour times extinction (0 where opaque)
   double T;       // integral of tau from node 0 to this node
+  double M;       // integral of x tau from node 0 (x: table coordinate), for the centroid
   double K[3];    // integral of c tau from node 0
   double opaque;  // 1 where the opacity is 1, else 0
   double O;       // integral of `opaque` from node 0
@@ -56,7 +57,7 @@ inline constexpr double kMinSpan = 1e-2;
 // The integrals at one scalar (a segment end).
 struct End {
   double x = 0;  // table coordinate, unclamped
-  double tau = 0, k[3] = {0, 0, 0}, T = 0, K[3] = {0, 0, 0}, opaque = 0, O = 0;
+  double tau = 0, k[3] = {0, 0, 0}, T = 0, M = 0, K[3] = {0, 0, 0}, opaque = 0, O = 0;
 };
 
 // Outside the nodes the transfer function is clamped, so the integrals go
@@ -77,6 +78,10 @@ struct End {
   };
   e.tau = point(a.tau, b.tau);
   e.T = a.T + partial(a.tau, b.tau) + beyond * e.tau;
+  // Integral over [i, i + w] of (i + u) tau(u), tau linear; beyond, tau constant.
+  const double dtau = b.tau - a.tau;
+  e.M = a.M + double(i) * partial(a.tau, b.tau) + w * w * (0.5 * a.tau + w * dtau / 3.0) +
+        0.5 * e.tau * beyond * (e.x + xc);
   for (int c = 0; c < 3; ++c) {
     e.k[c] = point(a.k[c], b.k[c]);
     e.K[c] = a.K[c] + partial(a.k[c], b.k[c]) + beyond * e.k[c];
@@ -102,7 +107,7 @@ struct End {
 // The segment from `front` to `back`, `length` world units long:
 // premultiplied colour and opacity.
 [[gnu::always_inline]] inline Rgba segment(const PreintegralTables& t, const End& front,
-                                           const End& back, double length) {
+                                           const End& back, double length, float* centre = nullptr) {
   const double dx = back.x - front.x;
   const bool wide = std::abs(dx) > kMinSpan;
   if ((wide && back.O != front.O) || front.opaque > 0 || back.opaque > 0)
@@ -117,7 +122,23 @@ struct End {
     for (int c = 0; c < 3; ++c) k[c] = 0.5 * (front.k[c] + back.k[c]);
   }
   if (!(tau > 0)) return {};
-  const double alpha = -std::expm1(-tau * length);
+  const double depth = tau * length;
+  const double alpha = -std::expm1(-depth);
+  if (centre) {
+    // The extinction's centroid along the segment (from the first moment;
+    // near-equal ends: from the ends' extinctions, linear between them),
+    // moved towards the front as self-attenuation weights it (exact for a
+    // homogeneous segment: 1/D - 1/(e^D - 1) of its length).
+    double at;
+    if (wide) {
+      at = ((back.M - front.M) / (back.T - front.T) - front.x) / dx;
+    } else {
+      const double sum = front.tau + back.tau;
+      at = sum > 0 ? (front.tau + 2 * back.tau) / (3 * sum) : 0.5;
+    }
+    at += depth < 1e-3 ? -depth / 12 : 1 / depth - 1 / std::expm1(depth) - 0.5;
+    *centre = float(std::clamp(at, 0.0, 1.0));
+  }
   const double w = alpha / tau;  // mean colour c = k / tau, times alpha
   return {float(k[0] * w), float(k[1] * w), float(k[2] * w), float(alpha)};
 }

@@ -124,12 +124,14 @@ PreintegratedTable::PreintegratedTable(const TransferFunctionSpec& tf) {
         opaque ? Rgba{float(m.r), float(m.g), float(m.b), 1.0f} : Rgba{};
   }
   // Cumulative integrals of the piecewise-linear node values (trapezoids).
-  nodes_[0].T = nodes_[0].O = 0;
+  nodes_[0].T = nodes_[0].M = nodes_[0].O = 0;
   for (int k = 0; k < 3; ++k) nodes_[0].K[k] = 0;
   for (int i = 1; i < n; ++i) {
     const PreintegralNode& a = nodes_[i - 1];
     PreintegralNode& b = nodes_[i];
     b.T = a.T + 0.5 * (a.tau + b.tau);
+    // Integral over [i - 1, i] of x tau(x), tau linear: (i - 1) (a + b) / 2 + (a + 2 b) / 6.
+    b.M = a.M + double(i - 1) * 0.5 * (a.tau + b.tau) + (a.tau + 2 * b.tau) / 6.0;
     for (int k = 0; k < 3; ++k) b.K[k] = a.K[k] + 0.5 * (a.k[k] + b.k[k]);
     b.O = a.O + 0.5 * (a.opaque + b.opaque);
   }

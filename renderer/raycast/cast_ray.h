@@ -19,24 +19,24 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
   const T* v = static_cast<const T*>(p.voxels);
   const float o0 = float(ray.origin[0]), o1 = float(ray.origin[1]), o2 = float(ray.origin[2]);
   const float d0 = float(ray.step[0]), d1 = float(ray.step[1]), d2 = float(ray.step[2]);
-  float front = 0;
-  preint::End frontEnd;
-  if constexpr (kPreintegrated) {
-    front = around(v, p, o0 + float(start) * d0, o1 + float(start) * d1, o2 + float(start) * d2);
-    frontEnd = segmentEnd<T>(p, front);
-  }
+  // Pre-integrated: the samples at s - 1, s and s + 1 and segment s's front end.
+  PreintWindow w;
+  if constexpr (kPreintegrated) w = preintWindow<T>(p, ray, start);
+  float centre = 0.5f;  // pre-integrated: where in its segment to light it
   for (std::int64_t s = start; s < exit; ++s) {
     const float x0 = o0 + float(s) * d0, x1 = o1 + float(s) * d1, x2 = o2 + float(s) * d2;
     Rgba c;
     if constexpr (kPreintegrated) {
-      // Sample s + 1's position by the same formula as every sample's, so a
-      // run that starts at s + 1 reads exactly the value carried here.
-      const float back = around(v, p, o0 + float(s + 1) * d0, o1 + float(s + 1) * d1, o2 + float(s + 1) * d2);
-      const preint::End backEnd = segmentEnd<T>(p, back);
-      c = finite<T>(front) && finite<T>(back) ? preint::segment(p.preint, frontEnd, backEnd, p.stepLength)
-                                              : Rgba{};
-      front = back;
-      frontEnd = backEnd;
+      // Sample s + 2's position by the same formula as every sample's, so a
+      // run that starts later reads exactly the values carried here.
+      const float next = around(v, p, o0 + float(s + 2) * d0, o1 + float(s + 2) * d1, o2 + float(s + 2) * d2);
+      float lo, hi;
+      aroundRange(v, p, o0 + float(s + 1) * d0, o1 + float(s + 1) * d1, o2 + float(s + 1) * d2, lo, hi);
+      const preint::End backEnd = segmentEnd<T>(p, curvedNode<T>(w.front, w.back, next, lo, hi));
+      c = finite<T>(w.front) && finite<T>(w.back)
+              ? preint::segment(p.preint, w.frontEnd, backEnd, p.stepLength, &centre)
+              : Rgba{};
+      w.advance(next, backEnd);
     } else {
       const float value = trilinear(v, p, x0, x1, x2, p.ownCellLo, p.ownCellHi);
       c = finite<T>(value) ? classify1D(p, value) : Rgba{};
@@ -47,7 +47,7 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
       // Pre-integrated: lit at the segment's middle, where the plain
       // kernel's segment has its sample (second-order accurate).
       if constexpr (kPreintegrated) {
-        const float t = float(s) + 0.5f;
+        const float t = float(s) + centre;
         c = shade(v, p, ray, o0 + t * d0, o1 + t * d1, o2 + t * d2, c);
       } else {
         c = shade(v, p, ray, x0, x1, x2, c);
@@ -127,13 +127,7 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
 #ifdef PVR_HAVE_BATCH_KERNEL
     if (p.indices32) {
       if constexpr (kPreintegrated) {
-        const T* v = static_cast<const T*>(p.voxels);
-        float front = around(v, p, float(ray.origin[0]) + float(start) * float(ray.step[0]),
-                             float(ray.origin[1]) + float(start) * float(ray.step[1]),
-                             float(ray.origin[2]) + float(start) * float(ray.step[2]));
-        preint::End frontEnd = segmentEnd<T>(p, front);
-        if (runBatchedPreintegrated<T, kShaded>(p, ray, start, body, front, frontEnd, acc, samples))
-          return true;
+        if (runBatchedPreintegrated<T, kShaded>(p, ray, start, body, acc, samples)) return true;
       } else {
         if (runBatched<T, kShaded>(p, ray, start, body, acc, samples)) return true;
       }

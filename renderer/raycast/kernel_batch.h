@@ -141,10 +141,12 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
 
 // The scalars at samples [first, first + 8) as `around` reads them
 // (positions clamped into the domain, cells into the stored box): a
-// pre-integrated segment's ends may lie beyond the owned box.
+// pre-integrated segment's ends may lie beyond the owned box. `lo` and
+// `hi` get the ranges of their cells' nodes (aroundRange()).
 template <typename T>
 [[gnu::always_inline]] inline __m256 aroundBatch(const T* v, const KernelParams& p, const __m256 o[3],
-                                                 const __m256 d[3], std::int64_t first) {
+                                                 const __m256 d[3], std::int64_t first, __m256& lo,
+                                                 __m256& hi) {
   const __m256 k = _mm256_add_ps(_mm256_set1_ps(float(first)), _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7));
   __m256 f[3];
   __m256i cell[3];
@@ -164,43 +166,76 @@ template <typename T>
   loadPairs8(v, index, p.strideY, b0, b1);
   loadPairs8(v, index, p.strideZ, c0, c1);
   loadPairs8(v, index, p.strideY + p.strideZ, e0, e1);
+  lo = _mm256_min_ps(_mm256_min_ps(_mm256_min_ps(a0, a1), _mm256_min_ps(b0, b1)),
+                     _mm256_min_ps(_mm256_min_ps(c0, c1), _mm256_min_ps(e0, e1)));
+  hi = _mm256_max_ps(_mm256_max_ps(_mm256_max_ps(a0, a1), _mm256_max_ps(b0, b1)),
+                     _mm256_max_ps(_mm256_max_ps(c0, c1), _mm256_max_ps(e0, e1)));
   return lerp8(lerp8(lerp8(a0, a1, f[0]), lerp8(b0, b1, f[0]), f[1]),
                lerp8(lerp8(c0, c1, f[0]), lerp8(e0, e1, f[0]), f[1]), f[2]);
 }
 
 // Pre-integrated segments [s, s + 1) for s in [start, exit), eight at a
-// time while eight remain: the eight back ends' scalars in one batch, the
-// segments (preintegration.h) and the "over" per segment in order. `front`
-// and `frontEnd` carry the front end of segment `start` in and the front of
-// the next segment out; `start` advances past what was done. Returns true
-// at the early-termination opacity.
+// time while eight remain: the scalars at s + 2 .. s + 9 in one batch, the
+// eight corrected nodes s + 1 .. s + 8 (curvedNode()) in another, the
+// segments (preintegration.h) and the "over" per segment in order; the
+// caller takes the rest one at a time. `start` advances past what was done.
+// Returns true at the early-termination opacity.
 template <typename T, bool kShaded>
 inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
-                                    std::int64_t exit, float& front, preint::End& frontEnd,
-                                    Accumulator& acc, std::uint64_t& samples) {
+                                    std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
+  if (start + 8 > exit) return false;
   const T* v = static_cast<const T*>(p.voxels);
   const __m256 o[3] = {_mm256_set1_ps(float(ray.origin[0])), _mm256_set1_ps(float(ray.origin[1])),
                        _mm256_set1_ps(float(ray.origin[2]))};
   const __m256 d[3] = {_mm256_set1_ps(float(ray.step[0])), _mm256_set1_ps(float(ray.step[1])),
                        _mm256_set1_ps(float(ray.step[2]))};
+  const PreintWindow w = preintWindow<T>(p, ray, start);
+  preint::End frontEnd = w.frontEnd;
+  // raw[j]: the sample at s + j, j in [0, 10); lo[j], hi[j] its cell's range.
+  alignas(32) float raw[16], lo[16], hi[16];
+  raw[0] = w.front;
+  raw[1] = w.back;
+  {
+    const float t = float(start + 1);
+    aroundRange(v, p, float(ray.origin[0]) + t * float(ray.step[0]), float(ray.origin[1]) + t * float(ray.step[1]),
+                float(ray.origin[2]) + t * float(ray.step[2]), lo[1], hi[1]);
+  }
   for (std::int64_t s = start; s + 8 <= exit; s += 8, start = s) {
+    __m256 lo8, hi8;
+    _mm256_storeu_ps(raw + 2, aroundBatch(v, p, o, d, s + 2, lo8, hi8));
+    _mm256_storeu_ps(lo + 2, lo8);
+    _mm256_storeu_ps(hi + 2, hi8);
+    const __m256 before = _mm256_loadu_ps(raw), at = _mm256_loadu_ps(raw + 1), after = _mm256_loadu_ps(raw + 2);
+    const __m256 bend = _mm256_add_ps(_mm256_sub_ps(before, _mm256_add_ps(at, at)), after);
+    __m256 node = _mm256_sub_ps(at, _mm256_mul_ps(bend, _mm256_set1_ps(1.0f / 12.0f)));
+    const __m256 clamped = _mm256_min_ps(_mm256_max_ps(node, _mm256_loadu_ps(lo + 1)), _mm256_loadu_ps(hi + 1));
+    if constexpr (std::is_floating_point_v<T>) {
+      const __m256 magnitude = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), node);
+      node = _mm256_blendv_ps(at, clamped, _mm256_cmp_ps(magnitude, _mm256_set1_ps(FLT_MAX), _CMP_LE_OQ));
+    } else {
+      node = clamped;
+    }
     alignas(32) float back[8];
-    _mm256_store_ps(back, aroundBatch(v, p, o, d, s + 1));
+    _mm256_store_ps(back, node);
     for (int lane = 0; lane < 8; ++lane) {
       const preint::End backEnd = segmentEnd<T>(p, back[lane]);
-      Rgba c = finite<T>(front) && finite<T>(back[lane])
-                   ? preint::segment(p.preint, frontEnd, backEnd, p.stepLength)
+      float centre = 0.5f;
+      Rgba c = finite<T>(raw[lane]) && finite<T>(raw[lane + 1])
+                   ? preint::segment(p.preint, frontEnd, backEnd, p.stepLength, &centre)
                    : Rgba{};
-      front = back[lane];
       frontEnd = backEnd;
       if constexpr (kShaded) {
         if (!(c.a > 0)) continue;
-        const float t = float(s + lane) + 0.5f;
+        const float t = float(s + lane) + centre;
         c = shade(v, p, ray, float(ray.origin[0]) + t * float(ray.step[0]),
                   float(ray.origin[1]) + t * float(ray.step[1]), float(ray.origin[2]) + t * float(ray.step[2]), c);
       }
       acc.addBehind(c);
     }
+    raw[0] = raw[8];
+    raw[1] = raw[9];
+    lo[1] = lo[9];
+    hi[1] = hi[9];
     samples += 8;
     if (acc.a >= p.earlyTermination) return true;
   }

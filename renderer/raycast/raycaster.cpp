@@ -46,9 +46,13 @@ int ghostLayers(const GridGeometry& grid, const RenderOptions& options) {
   int layers = options.shading.enabled ? 1 : 0;
   if (options.preintegrated) {
     const double steps = options.step / grid.minSpacing();
-    layers = std::max(layers, int(std::ceil(steps - 1e-9)));
-    // Lit at a segment's middle, half a step beyond the last owned sample.
-    if (options.shading.enabled) layers = std::max(layers, int(std::ceil(0.5 * steps - 1e-9)) + 1);
+    // A segment's back node is corrected with the sample one step further
+    // on (curvedNode()): reads reach two steps beyond the owned box.
+    layers = std::max(layers, int(std::ceil(2 * steps - 1e-9)));
+    // Lit inside its segment, up to a step beyond the last owned sample,
+    // with central differences one voxel further (within the two steps
+    // above from a step of one voxel on).
+    if (options.shading.enabled) layers = std::max(layers, int(std::ceil(steps - 1e-9)) + 1);
   }
   return layers;
 }

@@ -45,8 +45,9 @@ RenderOptions renderOptionsFor(const Scene& resolvedScene);
 
 // Ghost layers a brick needs beyond its owned box for these options:
 // trilinear sampling needs none (neighbours share the face nodes), central
-// differences one, a pre-integrated segment reaches one step beyond (and
-// is lit half a step beyond, one more for its central differences).
+// differences one, a pre-integrated segment reads two steps beyond (its
+// back node's curvature correction) and is lit up to a step beyond, one
+// more for its central differences.
 int ghostLayers(const GridGeometry& grid, const RenderOptions& options);
 
 struct RenderStats {
