@@ -34,7 +34,8 @@ Distribution distributeComputation(NodeState& state, int step) {
   Distribution d;
   std::vector<core::NodeBox> owned;
   comm::runAgreed(cluster, [&] {
-    core::KdTree tree = core::KdTree::build(computation.grid(), cluster.size(), splitAxisRule(state.settings.decomposition));
+    // The "kd" decomposition's tree: equal nodes per rank, axes alternating.
+    core::KdTree tree = core::KdTree::build(computation.grid(), cluster.size(), splitAxisRule(Decomposition::kKd));
     for (int r = 0; r < cluster.size(); ++r) owned.push_back(tree.ownedBox(r));
     d.tree = std::move(tree);
   });

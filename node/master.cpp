@@ -100,6 +100,10 @@ void Master::on(const proto::SetScene& request, std::uint32_t id) {
     if (auto refused = applyScene(proto::SetScene{"", nlohmann::json{{"camera", section}}.dump()}))
       return sendError(*refused, id);
   }
+  // Steering is answered between the waves of a sequence, when the link
+  // thread answers Status from its snapshot: the snapshot shows the change
+  // before the client learns it was made.
+  publishStatus();
   send(proto::Ok{}, id);
 }
 

@@ -9,7 +9,7 @@
 // grid in the world). lap is the 7-point Laplacian; the grid's faces are
 // no-flux (a missing neighbour mirrors the one inside: node -1 reads node
 // 1). Forward Euler is stable while a diffusion coefficient stays at or
-// below 1/6, the top of their ranges.
+// below 1/6; their ranges end at 0.16.
 #include <cmath>
 #include <cstdint>
 
@@ -89,8 +89,8 @@ ComputationEntry grayScott() {
       {
           {"feed", 0.035, 0, 0.1, "feed rate F: u flows in at F (1 - u)"},
           {"kill", 0.065, 0, 0.1, "kill rate k: v decays at (F + k) v"},
-          {"du", 0.16, 0, 1.0 / 6, "diffusion of u, grid units per step (stable up to 1/6)"},
-          {"dv", 0.08, 0, 1.0 / 6, "diffusion of v, grid units per step (stable up to 1/6)"},
+          {"du", 0.16, 0, 0.16, "diffusion of u, grid units per step (forward Euler is stable up to 1/6)"},
+          {"dv", 0.08, 0, 0.16, "diffusion of v, grid units per step (forward Euler is stable up to 1/6)"},
           {"field", 0, 0, 1, "the field drawn: 0 is v, 1 is u"},
       },
       {"u", "v"},

@@ -34,7 +34,7 @@ TEST_CASE("steering: parameters in range pass, out of range or undeclared are re
   REQUIRE(e);
   CHECK(e->text ==
         "parameters.speed: gray-scott has no parameter 'speed' (its parameters: feed [0, 0.1], kill [0, 0.1], "
-        "du [0, 0.16666666666666666], dv [0, 0.16666666666666666], field [0, 1])");
+        "du [0, 0.16], dv [0, 0.16], field [0, 1])");
 }
 
 TEST_CASE("steering: an unknown computation is refused naming the known ones") {
