@@ -24,6 +24,9 @@ struct ScratchDataDir {
     const fs::path d = fs::temp_directory_path() / ("pvr-scene-patch-" + std::to_string(::getpid()));
     fs::create_directories(d);
     std::ofstream(d / "ct.json") << "{}";
+    // A real volume, for the catalog to list under its stem "head".
+    std::ofstream(d / "head.raw") << std::string(8, '\x01');
+    std::ofstream(d / "head.json") << R"({"dims": [2, 2, 2], "dtype": "uint8", "spacing": [1, 1, 1]})";
     // A FIFO, a symlink to a device and one leading outside: names a client
     // may give that must never be opened.
     ::mkfifo((d / "pipe.json").c_str(), 0600);
@@ -171,8 +174,8 @@ TEST_CASE("a volumes list replaces the session's volumes, its datasets resolved 
   CHECK(two.doc["volumes"][0]["visible"] == false);
   CHECK(two.doc["volumes"][1]["procedural"] == "marschner-lobb");
   // By catalog stem, as `list datasets` names it (and pvrd the dataset field).
-  const SessionScene stem = accepted(one, {"", R"({"volumes": [{"name": "ct", "dataset": "ct"}]})"});
-  CHECK(stem.doc["volumes"][0]["file"] == dataDir() + "/ct.json");
+  const SessionScene stem = accepted(one, {"", R"({"volumes": [{"name": "h", "dataset": "head"}]})"});
+  CHECK(stem.doc["volumes"][0]["file"] == dataDir() + "/head.json");
 
   auto e = refused(one, {"", R"({"volumes": [{"name": "a", "file": "/etc/passwd"}]})"});
   CHECK(e.code == proto::ErrorCode::kBadArgument);

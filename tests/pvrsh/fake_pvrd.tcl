@@ -175,10 +175,13 @@ proc ::fakepvrd::request {ch type id payload} {
                 send $ch Ok $id 1 ""
             }
         }
-        32 - 33 - 36 {
-            # RenderFrame (1 frame), RenderRotation (E - S + 1), RenderTimeSteps.
+        32 - 33 - 36 - 38 {
+            # RenderFrame (1 frame), RenderRotation (E - S + 1), RenderTimeSteps,
+            # RenderInteractive (the coarse frame, then the full one).
             set count 1
-            if {$type == 33} {
+            if {$type == 38} {
+                set count 2
+            } elseif {$type == 33} {
                 binary scan $payload @24ii start end
                 set count [expr {$end - $start + 1}]
             } elseif {$type == 36} {
