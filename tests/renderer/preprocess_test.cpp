@@ -323,6 +323,38 @@ TEST_CASE("classification marks a macrocell visible exactly when its bounds are"
   }
 }
 
+TEST_CASE("fine counts of flat runs, runs broken by one voxel and changing values equal a count of every voxel", "[preprocess]") {
+  // Rows of 150 nodes: blocks of equal values are counted at once, a block
+  // with one other value voxel by voxel, and the rest of a row after the
+  // last whole block one by one.
+  const GridGeometry grid = gridOf({150, 6, 4});
+  for (ScalarType type : kTypes) {
+    CAPTURE(scalarName(type));
+    Brick b(grid, type, grid.allNodes(), grid.allNodes());
+    std::mt19937 rng(7);
+    dispatchScalar(type, [&](auto tag) {
+      using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+      T* v = b.as<T>();
+      for (std::int64_t z = 0; z < 4; ++z)
+        for (std::int64_t y = 0; y < 6; ++y)
+          for (std::int64_t x = 0; x < 150; ++x) {
+            T value = T(y + 3);                                        // flat
+            if (y % 3 == 1 && x == 70) value = T(100);                 // one voxel breaks a block
+            if (y % 3 == 2) value = T(std::uniform_int_distribution<int>(0, 120)(rng));  // changing
+            v[b.linearIndex({x, y, z})] = value;
+          }
+      b.updateValueRange();
+      std::vector<std::uint64_t> expected(fineKeyCount(type), 0);
+      const NodeBox counted = countedBox(b.owned(), grid);
+      for (std::int64_t z = counted.lo.z; z <= counted.hi.z; ++z)
+        for (std::int64_t y = counted.lo.y; y <= counted.hi.y; ++y)
+          for (std::int64_t x = counted.lo.x; x <= counted.hi.x; ++x) ++expected[fineKey(v[b.linearIndex({x, y, z})])];
+      REQUIRE(b.fineHistogram());
+      CHECK(b.fineHistogram()->counts == expected);
+    });
+  }
+}
+
 TEST_CASE("content counts equal brute force for every scalar type, single-threaded and on a pool", "[preprocess]") {
   ThreadPool pool(2);
   std::uint32_t seed = 100;
