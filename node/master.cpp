@@ -23,8 +23,7 @@ constexpr int kReadAheadFrames = 32;
 // Requests the master answers between the waves of a sequence (Status and
 // Cancel the link thread answers at once); steering takes effect there.
 bool answeredBetweenWaves(const proto::Message& m) {
-  return std::holds_alternative<proto::StatusRequest>(m) || std::holds_alternative<proto::PerformanceRequest>(m) ||
-         isSteeringPatch(m);
+  return proto::isQuery(m) || isSteeringPatch(m);
 }
 
 void requireDataset(const NodeState& state) {

@@ -27,8 +27,7 @@ constexpr auto kCloseGrace = std::chrono::seconds(5);
 // A request that asks the master for work, which an interactive render's
 // full-quality frame gives way to (giveWayToNewer); queries do not.
 bool asksForWork(const proto::Message& m) {
-  return !std::holds_alternative<proto::StatusRequest>(m) && !std::holds_alternative<proto::PerformanceRequest>(m) &&
-         !std::holds_alternative<proto::CatalogRequest>(m);
+  return !proto::isQuery(m);
 }
 
 std::vector<std::uint8_t> encodeFinal(const proto::Message& m, std::uint32_t id, bool final = true) {

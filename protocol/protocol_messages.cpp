@@ -74,6 +74,11 @@ bool isRenderRequest(const Message& m) {
          std::holds_alternative<RenderInteractive>(m);
 }
 
+bool isQuery(const Message& m) {
+  return std::holds_alternative<StatusRequest>(m) || std::holds_alternative<PerformanceRequest>(m) ||
+         std::holds_alternative<CatalogRequest>(m);
+}
+
 std::optional<ProtocolError> ImageFrame::checkHead(std::uint64_t pixelBytes, const Limits& limits) const {
   const std::string size = std::to_string(width) + " x " + std::to_string(height);
   if (width == 0 || height == 0) {

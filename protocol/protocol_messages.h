@@ -431,4 +431,9 @@ using Message = std::variant<
 // last FINAL, which may stream for a long time.
 bool isRenderRequest(const Message& m);
 
+// Whether `m` only asks about the session (StatusRequest,
+// PerformanceRequest, CatalogRequest): it changes nothing and asks for no
+// frames, so it may be answered between or during another request's work.
+bool isQuery(const Message& m);
+
 }  // namespace pvr::proto
