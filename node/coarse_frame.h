@@ -1,8 +1,10 @@
 // The coarse frame of an interactive render (proto::RenderInteractive):
 // the wave renders, composites and collects a frame of 1/reduction of the
-// pixels per axis, and the collector upscales it to the session's image
-// size, so that every client sees frames of one size (docs/runtime.md,
-// "Progressive refinement").
+// pixels per axis, and the collector sends it at that size; the client
+// zooms it to the image size (docs/runtime.md, "Progressive refinement").
+// Sending it small is the point: converting, compressing, sending and
+// decoding a frame cost by its pixels, and an upscaled frame has r^2 times
+// the pixels of the information it carries.
 #pragma once
 
 #include "image.h"
@@ -11,13 +13,9 @@
 namespace pvr::node {
 
 // Pixels along an axis of `size` pixels at 1/reduction: rounded up, so a
-// coarse frame never has fewer than one pixel, nor covers less of the view.
+// coarse frame never has fewer than one pixel, nor covers less of the view
+// once zoomed by `reduction`.
 int reducedSize(int size, int reduction);
-
-// `coarse` (a full frame) stretched to width x height by bilinear
-// interpolation between pixel centres, clamped at the edges. Colours are
-// premultiplied, so blending them is blending light and coverage alike.
-core::Image upscaleFrame(const core::Image& coarse, int width, int height);
 
 // While it lives, `image` is reduced to 1/reduction per axis (reduction 1:
 // unchanged); then restored. Every rank holds one for the same wave, so
@@ -28,8 +26,6 @@ class ReducedImage {
   ~ReducedImage() { image_ = full_; }
   ReducedImage(const ReducedImage&) = delete;
   ReducedImage& operator=(const ReducedImage&) = delete;
-  // The size frames are sent at.
-  const core::ImageSpec& full() const { return full_; }
 
  private:
   core::ImageSpec& image_;

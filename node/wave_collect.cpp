@@ -8,7 +8,6 @@
 #include <string>
 #include <vector>
 
-#include "coarse_frame.h"
 #include "frame_pixels.h"
 #include "wave_io.h"
 
@@ -62,8 +61,7 @@ std::vector<double> frameTimes(const std::vector<comm::Bytes>& perRank, std::siz
 
 }  // namespace
 
-void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame, const core::ImageSpec& sent,
-                 std::optional<comm::Failure>& failure) {
+void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame, std::optional<comm::Failure>& failure) {
   // Timings of every rank, gathered; the pending charges go to the wave's
   // first frame.
   const std::size_t slots = state.wave.size();
@@ -89,13 +87,12 @@ void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFram
       core::Image frame = core::Image::fullFrame(width, height);
       for (const auto& [key, band] : state.bands)
         if (key.first == int(s)) paste(frame, band);
-      if (width != sent.width || height != sent.height) frame = upscaleFrame(frame, sent.width, sent.height);
       const std::uint32_t number = state.wave[s].number;
       if (!state.dumpDir.empty()) dumpFloat(state.dumpDir, request, number, frame);
       proto::ImageFrame out;
       out.frameNumber = number;
-      out.width = std::uint32_t(sent.width);
-      out.height = std::uint32_t(sent.height);
+      out.width = std::uint32_t(width);
+      out.height = std::uint32_t(height);
       out.format = state.settings.format;
       setFramePixels(out, frame, state.scene.image.background, state.settings.compression);
       if (s == 0) {

@@ -16,9 +16,8 @@ namespace pvr::node {
 // frame also carries dist: the command's broadcast plus the slowest rank's
 // (re)distribution since the last frame. The collector sends nothing when
 // it knows of a failure (`failure`, its own or a band's); a failure while
-// sending goes into `failure` and stops it. Frames go out at `sent`'s
-// size, upscaled from state.scene.image's when a coarse wave reduced it.
-void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame, const core::ImageSpec& sent,
-                 std::optional<comm::Failure>& failure);
+// sending goes into `failure` and stops it. Frames go out at
+// state.scene.image's size: a coarse wave's reduced one (coarse_frame.h).
+void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame, std::optional<comm::Failure>& failure);
 
 }  // namespace pvr::node

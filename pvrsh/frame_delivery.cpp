@@ -16,12 +16,21 @@ void Session::handleFrame(std::uint32_t id, const proto::ImageFrame& f, bool com
   try {
     const std::uint64_t number = framesReceived_++;
     const Pixels pixels = decodePixels(f);
+    // An interactive render's coarse frame comes at 1/r of the image size
+    // per axis; the window and files show it zoomed to the image size,
+    // which the session set (docs/pvrsh.md).
+    const int zoom = book_.sequences.at(id).frames.back().reduction;
+    const auto [width, height] = zoom > 1 ? imageSize(accepted_) : std::pair{pixels.width, pixels.height};
     // Sinks: the photo, then files, then the callback (which may look at both).
-    if (!photo_.empty()) putPhoto(interp_, photo_, pixels);
-    if (!dir_.empty()) writePng(pixels, numberedInDirectory(dir_, name_).name(number));
-    if (!files_.empty()) {
-      writePng(pixels, files_.name(number));
-      if (count == 1) firstFileNumber_ = number;
+    if (!photo_.empty()) putPhoto(interp_, photo_, pixels, zoom, width, height);
+    if (!dir_.empty() || !files_.empty()) {
+      const Pixels shown = zoom > 1 ? zoomPixels(pixels, zoom, width, height) : Pixels{};
+      const Pixels& written = zoom > 1 ? shown : pixels;
+      if (!dir_.empty()) writePng(written, numberedInDirectory(dir_, name_).name(number));
+      if (!files_.empty()) {
+        writePng(written, files_.name(number));
+        if (count == 1) firstFileNumber_ = number;
+      }
     }
   } catch (const TclError& e) {
     abandonSequence(id, complete, e);

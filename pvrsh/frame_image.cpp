@@ -3,6 +3,7 @@
 #include <tk.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -86,7 +87,26 @@ bool tkAvailable(Tcl_Interp* interp) {
   return true;
 }
 
+Pixels zoomPixels(const Pixels& pixels, int zoom, int width, int height) {
+  Pixels out;
+  out.width = width;
+  out.height = height;
+  out.channels = pixels.channels;
+  const std::size_t c = std::size_t(pixels.channels);
+  out.bytes.resize(std::size_t(width) * std::size_t(height) * c);
+  std::uint8_t* o = out.bytes.data();
+  for (int y = 0; y < height; ++y) {
+    const std::uint8_t* row = pixels.bytes.data() + std::size_t(std::min(y / zoom, pixels.height - 1)) * std::size_t(pixels.width) * c;
+    for (int x = 0; x < width; ++x, o += c) std::memcpy(o, row + std::size_t(std::min(x / zoom, pixels.width - 1)) * c, c);
+  }
+  return out;
+}
+
 void putPhoto(Tcl_Interp* interp, const std::string& photo, const Pixels& pixels) {
+  putPhoto(interp, photo, pixels, 1, pixels.width, pixels.height);
+}
+
+void putPhoto(Tcl_Interp* interp, const std::string& photo, const Pixels& pixels, int zoom, int width, int height) {
   if (!tkAvailable(interp))
     throw TclError({"PVR", "IMAGE", "NOTK"}, "image window needs Tk: package require Tk first (or run pvrsh with a display)");
   Tk_PhotoHandle handle = Tk_FindPhoto(interp, photo.c_str());
@@ -101,8 +121,12 @@ void putPhoto(Tcl_Interp* interp, const std::string& photo, const Pixels& pixels
   block.offset[1] = 1;
   block.offset[2] = 2;
   block.offset[3] = pixels.channels == 4 ? 3 : 0;
-  if (Tk_PhotoSetSize(interp, handle, pixels.width, pixels.height) != TCL_OK ||
-      Tk_PhotoPutBlock(interp, handle, &block, 0, 0, pixels.width, pixels.height, TK_PHOTO_COMPOSITE_SET) != TCL_OK)
+  const auto put = [&] {
+    return zoom == 1 ? Tk_PhotoPutBlock(interp, handle, &block, 0, 0, width, height, TK_PHOTO_COMPOSITE_SET)
+                     : Tk_PhotoPutZoomedBlock(interp, handle, &block, 0, 0, width, height, zoom, zoom, 1, 1,
+                                              TK_PHOTO_COMPOSITE_SET);
+  };
+  if (Tk_PhotoSetSize(interp, handle, width, height) != TCL_OK || put() != TCL_OK)
     throw TclError({"PVR", "IMAGE", "PHOTO"}, std::string("cannot put the frame into ") + photo + ": " +
                                                  Tcl_GetStringResult(interp));
 }

@@ -30,10 +30,18 @@ Pixels decodePixels(const proto::ImageFrame& frame);
 // level 1). Throws TclError {PVR IO} when the file cannot be written.
 void writePng(const Pixels& pixels, const std::string& path);
 
-// Puts `pixels` into the Tk photo image `photo`, resizing it to the frame.
+// `pixels` zoomed by `zoom` (each pixel a zoom x zoom block, as Tk's
+// `copy -zoom` does) and cut to width x height: an interactive render's
+// coarse frame at the image size (docs/pvrsh.md).
+Pixels zoomPixels(const Pixels& pixels, int zoom, int width, int height);
+
+// Puts `pixels` into the Tk photo image `photo`, resizing it to the frame;
+// with `zoom` > 1, zoomed and cut to width x height as zoomPixels does
+// (Tk zooms it into the photo, with no copy of the pixels).
 // Throws TclError {PVR IMAGE NOTK} when Tk is not loaded in `interp` and
 // {PVR IMAGE NOPHOTO} when no photo image has that name.
 void putPhoto(Tcl_Interp* interp, const std::string& photo, const Pixels& pixels);
+void putPhoto(Tcl_Interp* interp, const std::string& photo, const Pixels& pixels, int zoom, int width, int height);
 
 // True when Tk is loaded in `interp` and its stubs are ready for putPhoto.
 bool tkAvailable(Tcl_Interp* interp);

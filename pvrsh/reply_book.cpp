@@ -59,7 +59,8 @@ Arrival ReplyBook::route(const proto::Decoded& d, Clock::time_point now) {
       r.arrival = seconds(now - seq.sent);
       r.width = int(f->width);
       r.height = int(f->height);
-      r.coarse = seq.interactive && f->frameNumber == 0;
+      r.coarse = seq.reduction > 1 && f->frameNumber == 0;
+      if (r.coarse) r.reduction = seq.reduction;
       seq.frames.push_back(r);
       a.kind = Arrival::Kind::kFrame;
       a.frame = f;

@@ -41,8 +41,9 @@ struct FrameRecord {
   std::uint32_t frame = 0;
   proto::FrameTiming timing;
   double arrival = 0;  // seconds since the request was sent
-  int width = 0, height = 0;
+  int width = 0, height = 0;  // the frame's own size (a coarse frame's is reduced)
   bool coarse = false;  // the coarse frame of an interactive render (proto::RenderInteractive)
+  int reduction = 1;    // a coarse frame's pixels per axis: the client zooms it by this
 };
 
 // A render request in flight: RenderFrame, RenderRotation or RenderTimeSteps.
@@ -53,7 +54,9 @@ struct Sequence {
   Clock::time_point sent;
   std::vector<FrameRecord> frames;
   bool cancelled = false;    // ended early (cancel, or a frame pvrsh could not deliver)
-  bool interactive = false;  // RenderInteractive: frame 0 is coarse, frame 1 full
+  // RenderInteractive's reduction: frame 0 is coarse, at 1/reduction of the
+  // image size per axis, and frame 1 full; 0: not interactive.
+  int reduction = 0;
 };
 
 // A request whose answer someone waits for (open, queries) or that only

@@ -6,9 +6,11 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <optional>
+#include <string_view>
 
 #include "tcl_util.h"
 
@@ -449,6 +451,17 @@ std::string shownOption(Tcl_Interp* interp, const Settings& settings, Tcl_Obj* o
   for (const auto& [k, v] : settings.shown)
     if (k == kOptions[index].name) return v;
   return "";
+}
+
+std::pair<int, int> imageSize(const Settings& settings) {
+  const nlohmann::json& image = settings.scene.contains("image") ? settings.scene["image"] : nlohmann::json::object();
+  for (const OptionRow& row : kOptions)
+    if (std::string_view(row.name) == "-imagesz") {
+      int width = 0, height = 0;
+      std::sscanf(row.byDefault, "%d,%d", &width, &height);
+      return {image.value("width", width), image.value("height", height)};
+    }
+  return {0, 0};
 }
 
 // A list whose elements are one per line, so that an interactive shell

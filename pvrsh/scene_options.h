@@ -77,6 +77,10 @@ const std::vector<std::string>& transferOptionNames();
 // the known options.
 std::string shownOption(Tcl_Interp* interp, const Settings& settings, Tcl_Obj* option);
 
+// The image size the server renders for `settings`: -imagesz as set, else
+// its default (the option table's, which is the server's).
+std::pair<int, int> imageSize(const Settings& settings);
+
 // `:s set` with no argument: every option as {option value default}, in
 // table order, one per line; value is "" for an option never given.
 Tcl_Obj* optionListing(const Settings& settings);

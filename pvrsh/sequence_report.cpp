@@ -48,6 +48,7 @@ Tcl_Obj* timingDict(const FrameRecord& r) {
   Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj("width", -1), Tcl_NewIntObj(r.width));
   Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj("height", -1), Tcl_NewIntObj(r.height));
   Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj("quality", -1), Tcl_NewStringObj(r.coarse ? "coarse" : "full", -1));
+  Tcl_DictObjPut(nullptr, d, Tcl_NewStringObj("reduction", -1), Tcl_NewIntObj(r.reduction));
   return d;
 }
 

@@ -111,7 +111,8 @@ std::uint32_t Session::render(const proto::Message& request, std::uint32_t total
     layoutPending_ = false;
   }
   const std::uint32_t id = send(request, false);
-  book_.start(id, label, total, Clock::now()).interactive = std::holds_alternative<proto::RenderInteractive>(request);
+  const auto* interactive = std::get_if<proto::RenderInteractive>(&request);
+  book_.start(id, label, total, Clock::now()).reduction = interactive ? int(interactive->reduction) : 0;
   return id;
 }
 

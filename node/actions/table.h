@@ -63,7 +63,7 @@ struct Wave {
   // it ahead (brick_cache.h).
   std::vector<std::int32_t> upcoming;
   // 1, or an interactive render's coarse wave: its frames are rendered at
-  // 1/reduction of the pixels per axis and sent upscaled (coarse_frame.h).
+  // 1/reduction of the pixels per axis and sent at that size (coarse_frame.h).
   std::int32_t reduction = 1;
   static auto fields(auto& self) {
     return std::tie(self.request, self.frames, self.lastFrame, self.upcoming, self.reduction);

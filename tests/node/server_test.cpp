@@ -31,7 +31,6 @@
 #include <thread>
 
 #include "camera.h"
-#include "coarse_frame.h"
 #include "computation_run.h"
 #include "frame_pixels.h"
 #include "in_process_communicator.h"
@@ -1339,8 +1338,10 @@ TEST_CASE_METHOD(Fixture, "an interactive request sends a coarse frame, then the
   job.expect<proto::Ok>();
   const Reference ref(nlohmann::json::object());
   // The coarse frame: the view rendered at 1/4 of the pixels per axis
-  // (16 x 16), upscaled to the session's 64 x 64.
+  // (16 x 16) and sent at that size, as a direct render at 16 x 16 is;
+  // the client zooms it.
   const Reference coarse(nlohmann::json::parse(R"({"image": {"width": 16, "height": 16}})"));
+  std::vector<std::uint8_t> coarseBytes;  // turn 5's coarse frame on the wire
   for (const std::int32_t turn : {0, 5}) {
     INFO("turn " << turn);
     const auto id = job.send(proto::RenderInteractive{4, {0, 1, 0}, turn, 60});
@@ -1351,9 +1352,9 @@ TEST_CASE_METHOD(Fixture, "an interactive request sends a coarse frame, then the
     CHECK(first->info.requestId == id);
     CHECK_FALSE(first->info.final());
     CHECK(quick.frameNumber == 0);
-    CHECK(quick.width == 64);
-    CHECK(quick.height == 64);
-    CHECK(core::maxAbsDifference(dumped(job, id, 0), node::upscaleFrame(coarse.frame(turn, 60), 64, 64)) <= 1e-5);
+    CHECK(quick.width == 16);
+    CHECK(quick.height == 16);
+    CHECK(core::maxAbsDifference(dumped(job, id, 0), coarse.frame(turn, 60)) <= 1e-5);
     auto second = job.receive();
     REQUIRE(second);
     if (const auto* e = std::get_if<proto::ErrorMessage>(&second->message)) FAIL(e->text);
@@ -1368,7 +1369,16 @@ TEST_CASE_METHOD(Fixture, "an interactive request sends a coarse frame, then the
     else job.send(proto::RenderRotation{{0, 1, 0}, turn, turn, 60});
     const auto normal = job.expect<proto::ImageFrame>();
     CHECK(normal.pixels == full.pixels);
+    coarseBytes = quick.pixels;
   }
+  // The coarse frame is, byte for byte, what a 16 x 16 session sends for
+  // that view.
+  job.send(proto::SetScene{"", R"({"image": {"width": 16, "height": 16}})"});
+  job.expect<proto::Ok>();
+  job.send(proto::RenderRotation{{0, 1, 0}, 5, 5, 60});
+  const auto small = job.expect<proto::ImageFrame>();
+  CHECK(small.width == 16);
+  CHECK(small.pixels == coarseBytes);
   CHECK(job.close());
 }
 

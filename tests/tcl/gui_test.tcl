@@ -215,6 +215,30 @@ check "editor: the histogram's bars are drawn" {[llength [.ctl.tf.editor find wi
     "[llength [.ctl.tf.editor find withtag histogram]] bars"
 
 # ---- Step 3: a drag on the image ----
+# Each coarse frame as the GUI is told of it: its own size and reduction,
+# the photo's size, and whether the photo holds it zoomed (every 4 x 4
+# block of pixels of one colour, as `copy -zoom 4` makes it).
+proc zoomedBlocks {zoom} {
+    foreach {bx by} {0 0 16 16 15 17 8 24} {
+        set want [$::photo get [expr {$bx * $zoom}] [expr {$by * $zoom}]]
+        for {set y 0} {$y < $zoom} {incr y} {
+            for {set x 0} {$x < $zoom} {incr x} {
+                if {[$::photo get [expr {$bx * $zoom + $x}] [expr {$by * $zoom + $y}]] ne $want} {
+                    return 0
+                }
+            }
+        }
+    }
+    return 1
+}
+set ::coarseShown {}
+trace add execution ::pvr::gui::onFrame enter {apply {{command op} {
+    set timing [lindex $command 2]
+    if {[dict get $timing quality] eq "coarse"} {
+        lappend ::coarseShown [list [dict get $timing width]x[dict get $timing height]/[dict get $timing reduction] \
+                                   [image width $::photo]x[image height $::photo] [zoomedBlocks 4]]
+    }
+}}}
 set sentBefore $::pvr::gui::view::sent
 set coarseBefore [expr {[info exists ::pvr::gui::coarseFrames] ? $::pvr::gui::coarseFrames : 0}]
 set az0 $::pvr::gui::view::azimuth
@@ -240,6 +264,9 @@ check "drag: coarse frames while dragging, the full-quality frame last" \
     {$::pvr::gui::coarseFrames > $coarseBefore && $::pvr::gui::lastQuality eq "full"} \
     "coarse [expr {$::pvr::gui::coarseFrames - $coarseBefore}], last $::pvr::gui::lastQuality"
 check "drag: the volume is still visible" {[lit] > 5} "lit [lit]"
+check "drag: coarse frames come at 32x32 and show zoomed to 128x128 in the photo" \
+    {[llength $::coarseShown] > 0 && [lsort -unique $::coarseShown] eq {{32x32/4 128x128 1}}} \
+    "[lsort -unique $::coarseShown]"
 
 # ---- Step 4: the turn-right button ----
 set sentBefore $::pvr::gui::view::sent
