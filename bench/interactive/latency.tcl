@@ -116,14 +116,16 @@ set firstPhoto {}
 set firstShown {}
 set overhead {}
 set phases $::pvr::phases
+set firstOverhead {}
 foreach p $phases {
     set sum($p) 0.0
+    set firstSum($p) 0.0
 }
 file mkdir $opt(-out)
 set csv [open [file join $opt(-out) $opt(-tag).csv] w]
 # The server's phases of the full frame, in $::pvr::phases order, then the
-# first pixels' times and the first frame's ray casting.
-puts $csv "frame,request_to_photo_s,request_to_shown_s,[join [lmap p $phases {string cat $p _s}] ,],request_to_first_photo_s,request_to_first_shown_s,first_rend_s"
+# first pixels' times and the first frame's phases.
+puts $csv "frame,request_to_photo_s,request_to_shown_s,[join [lmap p $phases {string cat $p _s}] ,],request_to_first_photo_s,request_to_first_shown_s,[join [lmap p $phases {string cat first_ $p _s}] ,]"
 set i 0
 foreach rec $records {
     # The full-quality frame, and the first pixels: the coarse frame's
@@ -151,7 +153,15 @@ foreach rec $records {
         set sum($p) [expr {$sum($p) + $v}]
         lappend row [format %.4f $v]
     }
-    lappend row [format %.4f $fp] [format %.4f $fs] [format %.4f [dict get [dict get $rec $first timing] rend]]
+    lappend row [format %.4f $fp] [format %.4f $fs]
+    set firstServer 0.0
+    foreach p $phases {
+        set v [dict get [dict get $rec $first timing] $p]
+        set firstSum($p) [expr {$firstSum($p) + $v}]
+        set firstServer [expr {$firstServer + $v}]
+        lappend row [format %.4f $v]
+    }
+    lappend firstOverhead [expr {$fp - $firstServer}]
     puts $csv [join $row ,]
     incr i
 }
@@ -168,6 +178,13 @@ puts "PVR interactive latency: $opt(-dataset), ${size}x${size}, $n frames after 
 puts [format "request-to-first-pixels  photo median %.3f s  p90 %.3f s;  shown median %.3f s  p90 %.3f s  (target 0.05 s: %s)" \
           [percentile $firstPhoto 0.5] [percentile $firstPhoto 0.9] [percentile $firstShown 0.5] \
           [percentile $firstShown 0.9] [expr {[percentile $firstShown 0.5] <= 0.05 ? "met" : "missed"}]]
+set parts {}
+foreach p $phases {
+    lappend parts [format "%s %.1f ms" $p [expr {$firstSum($p) / $n * 1e3}]]
+}
+puts "first frame's server phases, mean: [join $parts {  }]"
+puts [format "first frame outside the server's phases (dispatch, wire, decode, photo): median %.1f ms" \
+          [expr {[percentile $firstOverhead 0.5] * 1e3}]]
 puts "request-to-full-quality (below):"
 puts [format "request-to-photo  median %.3f s  p90 %.3f s" [percentile $photo 0.5] [percentile $photo 0.9]]
 puts [format "request-to-shown  median %.3f s  p90 %.3f s  (target 0.25 s: %s)" \
