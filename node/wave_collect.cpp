@@ -61,12 +61,15 @@ std::vector<double> frameTimes(const std::vector<comm::Bytes>& perRank, std::siz
 
 }  // namespace
 
-void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame, std::optional<comm::Failure>& failure) {
+void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame, bool coarse,
+                 std::optional<comm::Failure>& failure) {
   // Timings of every rank, gathered; the pending charges go to the wave's
-  // first frame.
+  // first frame. A coarse wave gathers nothing: the collector's own
+  // timings go with its frame, and the pending charges wait for the full
+  // frame's wave.
   const std::size_t slots = state.wave.size();
   std::vector<double> mine(at(slots, 0), 0.0);
-  if (slots > 0) {
+  if (slots > 0 && !coarse) {
     mine[kRead] = state.pendingRead;
     mine[kPreprocess] = state.pendingPreprocess;
     mine[kDistribute] = state.pendingDist;
@@ -77,7 +80,7 @@ void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFram
     mine[at(s, kComp)] = state.wave[s].comp;
     mine[at(s, kComm)] = state.wave[s].comm;
   }
-  const std::vector<double> times = frameTimes(state.world.allGather(std::as_bytes(std::span(mine))), slots);
+  const std::vector<double> times = coarse ? mine : frameTimes(state.world.allGather(std::as_bytes(std::span(mine))), slots);
   if (state.world.rank() != 0 || failure) return;
 
   const int width = state.scene.image.width, height = state.scene.image.height;

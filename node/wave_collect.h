@@ -11,13 +11,18 @@
 
 namespace pvr::node {
 
-// Collective over the world. Each frame carries rend, comp and comm as the
+// Collective over the world (but for a coarse wave). Each frame carries rend, comp and comm as the
 // max over ranks and send as the collector measured it; the wave's first
 // frame also carries dist: the command's broadcast plus the slowest rank's
 // (re)distribution since the last frame. The collector sends nothing when
 // it knows of a failure (`failure`, its own or a band's); a failure while
 // sending goes into `failure` and stops it. Frames go out at
 // state.scene.image's size: a coarse wave's reduced one (coarse_frame.h).
-void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame, std::optional<comm::Failure>& failure);
+// `coarse`: the wave of an interactive render's first pixels, which wait
+// for no collective of their own: no timings are gathered, the frame
+// carries the collector's own rend, comp and comm, and read, preprocess
+// and distribute stay pending for the next wave's frame.
+void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame, bool coarse,
+                 std::optional<comm::Failure>& failure);
 
 }  // namespace pvr::node

@@ -106,7 +106,7 @@ void Wave::run(NodeState& state, const Wave& args) {
   }
   renderMyFrame(state, args, failure);
   compositeWave(state, failure);
-  collectWave(state, args.request, args.lastFrame, failure);
+  collectWave(state, args.request, args.lastFrame, args.reduction > 1, failure);
   if (failure) throw comm::FailureError(*failure);
 }
 

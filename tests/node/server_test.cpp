@@ -1364,6 +1364,10 @@ TEST_CASE_METHOD(Fixture, "an interactive request sends a coarse frame, then the
     CHECK(full.frameNumber == 1);
     CHECK(core::maxAbsDifference(dumped(job, id, 1), ref.frame(turn, 60)) <= 1e-5);
     CHECK(quick.pixels != full.pixels);
+    // The coarse frame waits for no gathering of timings: the first
+    // request's reading of the bricks is charged to its full frame.
+    CHECK(quick.timing.read == 0);
+    if (turn == 0) CHECK(full.timing.read > 0);
     // The same view rendered normally: the very bytes of the full frame.
     if (turn == 0) job.send(proto::RenderFrame{});
     else job.send(proto::RenderRotation{{0, 1, 0}, turn, turn, 60});
