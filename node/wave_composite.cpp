@@ -71,6 +71,49 @@ void compositeSelf(NodeState& state, int slot, WaveFrame& w, std::optional<comm:
   deliver(state, slot, me.band, band, w.comm, failure);
 }
 
+// A coarse wave's small frame, in a cluster that composites itself: every
+// rank sends its sub-image (or its failure) straight to the cluster's rank
+// 0, which blends them front to back in visibility order. One message per
+// rank and no agreement, where the strategy's rounds, gather and
+// agreement would each wait for a rank to be scheduled: with few pixels
+// the messages' latency is all the compositing costs. The failure travels
+// with the sub-image, as to a composite cluster.
+void compositeAtRoot(NodeState& state, int slot, WaveFrame& w, std::optional<comm::Failure>& failure) {
+  const ClusterPlan& me = *state.myCluster();
+  comm::SubCommunicator& cluster = *state.clusterComm;
+  const int width = state.scene.image.width, height = state.scene.image.height;
+  if (cluster.rank() != 0) {
+    const auto t = Clock::now();
+    sendSubImage(cluster, 0, kPartialTag, {failure, failure ? core::Image() : w.partial});
+    w.comm += secondsSince(t);
+    return;
+  }
+  // Without a tree (the cluster's bricks could not be read, on all its
+  // ranks alike) the identity order keeps the receives matched.
+  std::vector<int> order(static_cast<std::size_t>(cluster.size()));
+  std::iota(order.begin(), order.end(), 0);
+  if (state.tree) {
+    try {
+      order = state.tree->visibilityOrder(core::Camera(w.camera, width, height));
+    } catch (...) {
+      keepFirst(failure, comm::failureOf(std::current_exception(), state.world.rank()));
+    }
+  }
+  core::Image acc(width, height, core::PixelRect{});
+  for (int r : order) {
+    auto t = Clock::now();
+    SubImage in = r == 0 ? SubImage{std::nullopt, std::move(w.partial)} : receiveSubImage(cluster, r, kPartialTag);
+    w.comm += secondsSince(t);
+    t = Clock::now();
+    keepFirst(failure, in.failure);
+    if (!failure) blendOver(acc, in.image);
+    w.comp += secondsSince(t);
+  }
+  SubImage band{failure, {}};
+  if (!failure) band.image = cropToRect(acc, bandRect(width, height, me.band, me.bands));
+  deliver(state, slot, me.band, band, w.comm, failure);
+}
+
 void sendToCompositors(NodeState& state, WaveFrame& w, std::optional<comm::Failure>& failure) {
   const ClusterPlan& me = *state.myCluster();
   const ClusterPlan& comp = state.layout.clusters[std::size_t(me.compositor)];
@@ -192,12 +235,13 @@ void receiveBands(NodeState& state, std::optional<comm::Failure>& failure) {
 
 }  // namespace
 
-void compositeWave(NodeState& state, std::optional<comm::Failure>& failure) {
+void compositeWave(NodeState& state, bool coarse, std::optional<comm::Failure>& failure) {
   state.bands.clear();
   const ClusterPlan* me = state.myCluster();
   if (me && me->role == proto::ClusterRole::kRender && me->group < int(state.wave.size())) {
     WaveFrame& w = state.wave[std::size_t(me->group)];
-    if (me->compositor < 0) compositeSelf(state, me->group, w, failure);
+    if (me->compositor < 0 && coarse) compositeAtRoot(state, me->group, w, failure);
+    else if (me->compositor < 0) compositeSelf(state, me->group, w, failure);
     else sendToCompositors(state, w, failure);
   } else if (me && me->role == proto::ClusterRole::kComposite) {
     compositeServed(state, failure);

@@ -4,7 +4,10 @@
 //
 //   - a render cluster without a composite cluster composites itself with
 //     the session's strategy on its cluster communicator; its rank 0 sends
-//     the band to the collector;
+//     the band to the collector. In a coarse wave (an interactive render's
+//     first pixels, coarse_frame.h) its ranks send their sub-images
+//     straight to its rank 0 instead, which blends them in visibility
+//     order: one message each, no strategy rounds, no agreement;
 //   - a render cluster served by a composite cluster of m ranks: its rank 0
 //     sends the frame's visibility order to the composite ranks; render
 //     rank at position p of that order sends its sub-image to composite
@@ -29,7 +32,8 @@ namespace pvr::node {
 
 // Collective over the world. `failure` comes in as this rank's failure so
 // far (its render) and goes out as the first failure this rank knows of:
-// its own, its cluster's, or at the collector any band's.
-void compositeWave(NodeState& state, std::optional<comm::Failure>& failure);
+// its own, its cluster's, or at the collector any band's. `coarse`: the
+// wave is a coarse one.
+void compositeWave(NodeState& state, bool coarse, std::optional<comm::Failure>& failure);
 
 }  // namespace pvr::node

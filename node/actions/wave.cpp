@@ -105,7 +105,7 @@ void Wave::run(NodeState& state, const Wave& args) {
     serveMyClusters(state, args);
   }
   renderMyFrame(state, args, failure);
-  compositeWave(state, failure);
+  compositeWave(state, args.reduction > 1, failure);
   collectWave(state, args.request, args.lastFrame, args.reduction > 1, failure);
   if (failure) throw comm::FailureError(*failure);
 }

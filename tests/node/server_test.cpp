@@ -1386,6 +1386,32 @@ TEST_CASE_METHOD(Fixture, "an interactive request sends a coarse frame, then the
   CHECK(job.close());
 }
 
+TEST_CASE_METHOD(Fixture, "a coarse frame composites at its cluster's root on 3 ranks, and a rank's failure reaches the client") {
+  Job job(3, {"--fail-once", "render@2"});
+  job.send(proto::SessionOpen{3, {}, ""});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  // Rank 2's coarse render fails: its failure goes with its sub-image to
+  // rank 0, which sends no coarse frame, only the failure.
+  job.send(proto::RenderInteractive{4, {0, 1, 0}, 0, 1});
+  CHECK_THAT(job.expectError().text, Catch::Contains("rank 2 on " + thisHost() + ": injected failure in render"));
+  // Then the three sub-images, blended front to back at rank 0, equal the
+  // view rendered whole at 16 x 16; the full frame follows.
+  const Reference ref(nlohmann::json::object());
+  const Reference coarse(nlohmann::json::parse(R"({"image": {"width": 16, "height": 16}})"));
+  for (const std::int32_t turn : {7, 20}) {
+    INFO("turn " << turn);
+    const auto id = job.send(proto::RenderInteractive{4, {0, 1, 0}, turn, 60});
+    const auto quick = job.expect<proto::ImageFrame>();
+    CHECK(quick.width == 16);
+    CHECK(core::maxAbsDifference(dumped(job, id, 0), coarse.frame(turn, 60)) <= 1e-5);
+    job.expect<proto::ImageFrame>();
+    CHECK(core::maxAbsDifference(dumped(job, id, 1), ref.frame(turn, 60)) <= 1e-5);
+  }
+  CHECK(job.close());
+}
+
 TEST_CASE_METHOD(Fixture, "a newer request cancels an interactive render's full frame, rendering or waiting") {
   Job job(2);
   openSlowSession(job, 2);
