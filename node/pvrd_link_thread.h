@@ -1,8 +1,11 @@
 // The master's link to pvrd, served by a thread of its own so that the
 // master answers while a frame renders (docs/runtime.md, "Liveness").
 //
-// The secure channel (an OpenSSL object) is not thread-safe, so this one
-// thread does every read and write on the link. It decodes the client's
+// The secure channel (an OpenSSL object) is not thread-safe: every read
+// and write on the link holds linkMutex_. This thread does them all but
+// one: send() writes a message itself when nothing waits in the outbox and
+// the link is free at that moment, so a frame does not wait for this
+// thread to be scheduled. It decodes the client's
 // requests and
 //   - answers a StatusRequest at once when only renders are ahead of it
 //     (running or queued), from the snapshot the main thread publishes
@@ -103,6 +106,9 @@ class LinkThread {
   comm::Liveness* liveness_;
   int wakeFd_ = -1;
 
+  // link_: held for each use of it; taken after mutex_ when both are held
+  // (send only tries it, so no order can deadlock).
+  std::mutex linkMutex_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;  // requests queued, outbox drained, link closed
   std::deque<proto::Decoded> requests_;

@@ -815,7 +815,10 @@ TEST_CASE_METHOD(Fixture, "requests flooding in during a sequence are kept up to
     }
   }
   // Kept ones render after the rotation; none is lost without an answer.
-  CHECK(rendered >= 64);
+  // 64 wait at most, the rotation among them when the flood arrives before
+  // the main thread took it (the Ok of SetScene leaves the main thread
+  // itself, so the client may answer it that soon).
+  CHECK(rendered >= 63);
   CHECK(refused > 0);
   CHECK(rendered + refused == kFlood);
   CHECK(job.close());
