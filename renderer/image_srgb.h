@@ -17,6 +17,9 @@ namespace pvr::core {
 // rounded to nearest: IEC 61966-2-1 curve (12.92 x below 0.0031308, else
 // 1.055 x^(1/2.4) - 0.055).
 std::uint8_t linearToSrgb8(double linear);
+// The same, computed from the curve for each call (a pow): what
+// linearToSrgb8's tables are checked against.
+std::uint8_t linearToSrgb8ByCurve(double linear);
 
 // An sRGB-encoded value (display colour, 1 = white) to linear light: the
 // inverse of the curve above (x / 12.92 up to 0.04045, else

@@ -101,6 +101,31 @@ TEST_CASE("linearToSrgb8 follows the sRGB curve", "[image]") {
   CHECK(linearToSrgb8(std::numeric_limits<double>::quiet_NaN()) == 0);
 }
 
+TEST_CASE("linearToSrgb8's tables give the curve's code for every value, at each code's edge too", "[image]") {
+  // Identity checked: linearToSrgb8(v) == linearToSrgb8ByCurve(v), where a
+  // code changes (the values around the inverse curve at k - 0.5, a few
+  // hundred doubles either side) and across (0, 1) and near 0.
+  int wrong = 0;
+  const auto check = [&](double v) {
+    if (linearToSrgb8(v) != linearToSrgb8ByCurve(v) && ++wrong <= 5)
+      FAIL_CHECK("v = " << v << ": " << int(linearToSrgb8(v)) << " against " << int(linearToSrgb8ByCurve(v)));
+  };
+  for (int k = 1; k <= 255; ++k) {
+    const double e = (k - 0.5) / 255.0;
+    const double edge = e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4);
+    double up = edge, down = edge;
+    for (int i = 0; i < 300; ++i) {
+      check(up);
+      check(down);
+      up = std::nextafter(up, 2.0);
+      down = std::nextafter(down, -1.0);
+    }
+  }
+  for (int i = 0; i < (1 << 20); ++i) check((i + 0.5) / (1 << 20));
+  for (double v = 1e-12; v < 1; v *= 1.001) check(v);
+  CHECK(wrong == 0);
+}
+
 TEST_CASE("PNG pixels are composited over the background and sRGB encoded", "[image]") {
   // Frame 4x1, rect covers pixels 0..2; pixel 3 is background only.
   Image image(4, 1, {0, 0, 3, 1});
