@@ -94,6 +94,14 @@ void LinkThread::send(const proto::Message& m, std::uint32_t id, bool final) {
     changed_.wait(lock, fits);
   }
   if (closed_ || closing_) return;
+  // The current request's last answer: it is answered, as take() would
+  // say. The client may send its next request as soon as it reads this,
+  // before the main thread is back in take(); a Status then must not wait
+  // behind a request already answered.
+  if (final && id != 0 && id == current_) {
+    current_ = 0;
+    currentIsRender_ = false;
+  }
   // Nothing waits before it and the link is free: written now, without
   // waiting for the thread to be scheduled (on a loaded machine that took
   // 7 ms of an interactive render's first pixels). The thread is still
