@@ -114,7 +114,7 @@ class LinkThread {
   std::deque<proto::Decoded> requests_;
   std::deque<std::vector<std::uint8_t>> outbox_;
   std::size_t outboxBytes_ = 0;
-  std::uint32_t current_ = 0;    // the request the main thread took last
+  std::uint32_t current_ = 0;    // the request the main thread took last, until its last answer is sent; 0: none
   bool currentIsRender_ = false;
   std::uint32_t rendering_ = 0;  // the render in progress; 0: none
   std::uint32_t givesWay_ = 0;   // the render a newer request stops (giveWayToNewer); 0: none
