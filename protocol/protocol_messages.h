@@ -311,7 +311,8 @@ struct RenderSteps {
 
 // Client -> server: one frame of the current view, progressively (a view
 // that is being dragged): first a coarse frame, 1/reduction of the pixels
-// per axis upscaled to the image size (ImageFrame 0, not FINAL), then the
+// per axis and sent at that size, for the client to zoom to the image size
+// (ImageFrame 0, not FINAL; docs/protocol.md), then the
 // full-quality frame (ImageFrame 1, FINAL) unless a newer request arrived
 // meanwhile, which ends this one with Error CANCELLED. The view is the
 // session's camera turned by 360 degrees * turn / stepsPerTurn about `axis`
