@@ -4,10 +4,12 @@
 #include <bit>
 #include <chrono>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include <unistd.h>
 
+#include "brick_summary.h"
 #include "byte_stream.h"
 #include "gzip_stream.h"
 #include "preprocess.h"
@@ -136,8 +138,15 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
   // forward), bring each to host order and preprocess it while it is in
   // cache: the voxels are touched once.
   const bool swap = size > 1 && layout.bigEndian != (std::endian::native == std::endian::big);
+  // A summary of this brick kept from an earlier read of the same file
+  // (brick_summary.h) stands for the preprocessing: the slabs are only read.
+  BrickSummaryCache summaries(layout, grid, type, owned, stored);
+  auto preStart = Clock::now();
+  std::optional<Preprocessed> summary = summaries.load();
   const NodeBox counted = countedBox(owned, grid);
-  SlabPreprocessor pre(type, owned, stored, &counted);
+  std::optional<SlabPreprocessor> pre;
+  if (!summary) pre.emplace(type, owned, stored, &counted);
+  const double summarySeconds = since(preStart);
   // The file bytes of the group of slabs starting at z0: from its first
   // run to the end of its last.
   auto groupOffset = [&](std::int64_t z0) {
@@ -192,16 +201,22 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
         }
       }
       brick.loadTimes().read += since(readStart);
-      const auto preStart = Clock::now();
+      const auto slabStart = Clock::now();
       if (swap) swapBytesInPlace(voxels + at, std::size_t(z1 - z0 + 1) * slabBytes / size, size);
-      pre.add(lent ? lent.get() + at : voxels + at, z0, z1);
-      brick.loadTimes().preprocess += since(preStart);
+      if (pre) pre->add(lent ? lent.get() + at : voxels + at, z0, z1);
+      brick.loadTimes().preprocess += since(slabStart);
     }
   });
-  const auto preStart = Clock::now();
-  Preprocessed result = pre.finish();
+  preStart = Clock::now();
+  Preprocessed result;
+  if (summary) {
+    result = std::move(*summary);
+  } else {
+    result = pre->finish();
+    summaries.store(result);
+  }
   brick.setPreprocessed(result.range, std::move(result.bounds), std::move(result.histogram));
-  brick.loadTimes().preprocess += since(preStart);
+  brick.loadTimes().preprocess += summarySeconds + since(preStart);
   return brick;
 }
 
