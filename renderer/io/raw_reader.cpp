@@ -63,8 +63,9 @@ class RawVolumeSource final : public VolumeSource {
   ScalarType type() const override { return type_; }
   bool canReadPartially() const override { return layout_.encoding == RawEncoding::kRaw; }
   Brick readBox(const NodeBox& owned, const NodeBox& stored) const override {
-    return readRawBox(layout_, grid_, type_, owned, stored);
+    return readRawBox(layout_, grid_, type_, owned, stored, fineCounts_);
   }
+  void setFineCounts(bool on) override { fineCounts_ = on; }
   std::string describe() const override { return name_ + ": " + shapeText(grid_, type_); }
 
  private:
@@ -72,6 +73,7 @@ class RawVolumeSource final : public VolumeSource {
   GridGeometry grid_;
   ScalarType type_;
   RawLayout layout_;
+  bool fineCounts_ = true;
 };
 
 }  // namespace
@@ -106,7 +108,7 @@ std::unique_ptr<VolumeSource> openRawVolume(std::string name, const GridGeometry
 }
 
 Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType type,
-                 const NodeBox& owned, const NodeBox& stored) {
+                 const NodeBox& owned, const NodeBox& stored, bool fineCounts) {
   using Clock = std::chrono::steady_clock;
   auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   checkReadBoxes(layout.dataPath, grid, owned, stored);
@@ -145,7 +147,7 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
   std::optional<Preprocessed> summary = summaries.load();
   const NodeBox counted = countedBox(owned, grid);
   std::optional<SlabPreprocessor> pre;
-  if (!summary) pre.emplace(type, owned, stored, &counted);
+  if (!summary) pre.emplace(type, owned, stored, fineCounts ? &counted : nullptr);
   const double summarySeconds = since(preStart);
   // The file bytes of the group of slabs starting at z0: from its first
   // run to the end of its last.

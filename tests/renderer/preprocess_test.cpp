@@ -483,8 +483,21 @@ TEST_CASE("the raw reader's fused preprocessing equals reading, then preprocessi
           REQUIRE(twoPass.macrocellBounds());
           CHECK(sameBounds(*fused.macrocellBounds(), *twoPass.macrocellBounds()));
           checkRange(fused.valueRange(), twoPass.valueRange());
+          REQUIRE(fused.fineHistogram());
+          REQUIRE(twoPass.fineHistogram());
+          CHECK(fused.fineHistogram()->counts == twoPass.fineHistogram()->counts);
           CHECK(fused.loadTimes().read > 0);
           CHECK(fused.loadTimes().preprocess > 0);
+
+          // Told to count nothing (pvr-node --batch): the same bounds and
+          // range, no histogram.
+          source->setFineCounts(false);
+          const Brick uncounted = source->readBox(owned, stored);
+          source->setFineCounts(true);
+          CHECK_FALSE(uncounted.fineHistogram());
+          REQUIRE(uncounted.macrocellBounds());
+          CHECK(sameBounds(*uncounted.macrocellBounds(), *twoPass.macrocellBounds()));
+          checkRange(uncounted.valueRange(), twoPass.valueRange());
         }
     }
 }
