@@ -147,7 +147,8 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
   std::optional<Preprocessed> summary = summaries.load();
   const NodeBox counted = countedBox(owned, grid);
   std::optional<SlabPreprocessor> pre;
-  if (!summary) pre.emplace(type, owned, stored, fineCounts ? &counted : nullptr);
+  // A summary to keep is whole: it counts even when this read need not.
+  if (!summary) pre.emplace(type, owned, stored, fineCounts || summaries.enabled() ? &counted : nullptr);
   const double summarySeconds = since(preStart);
   // The file bytes of the group of slabs starting at z0: from its first
   // run to the end of its last.

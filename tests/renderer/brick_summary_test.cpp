@@ -144,6 +144,21 @@ TEST_CASE("a brick's summary is kept, and a second read takes it, equal to prepr
   }
 }
 
+TEST_CASE("a read told to count nothing still keeps a whole summary, and takes it", "[preprocess][io]") {
+  // pvr-node --batch reads without fine counts (VolumeSource::setFineCounts);
+  // with summaries on, the read that writes one counts, for the server's
+  // histogram later.
+  const std::string dir = test::scratchDir("brick_summary_uncounted");
+  const ScalarType type = ScalarType::kUInt8;
+  const fs::path data = oldVolume(dir, "v.raw", type, 11);
+  const Brick counted = readBrick(data, type);
+  const SummaryDirectory cache(dir + "/summaries");
+  const Brick first = readRawBox(layoutOf(data), kGrid, type, kOwned, kStored, false);
+  REQUIRE(fs::exists(summaryPath(data, type)));
+  checkSame(first, counted);
+  checkSame(readRawBox(layoutOf(data), kGrid, type, kOwned, kStored, false), counted);
+}
+
 TEST_CASE("a summary is not used once its file changes, nor kept for a file written just now", "[preprocess][io]") {
   const std::string dir = test::scratchDir("brick_summary_changed");
   const SummaryDirectory cache(dir + "/summaries");
