@@ -166,6 +166,7 @@ PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& optio
   runAgreed(comm, [&] {
     composite::makeStrategy(options.strategy, options.strategyParams);
     source = options.openVolume ? options.openVolume(sceneIn.volumes.front().source) : core::openSceneVolume(sceneIn.volumes.front().source);
+    source->setFineCounts(false);  // a frame reports no histogram: the reader counts nothing
     result.scene = sceneIn;
     core::resolveDefaults(result.scene, source->grid());
     overrideEarlyTermination(result.scene, options);
@@ -186,7 +187,7 @@ PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& optio
   report.dist = std::max(0.0, secondsSince(distStart) - loaded.read - loaded.preprocess);
 
   // A transfer function left to the data takes the whole volume's range.
-  const std::optional<DataSummary> summary = summarizeData(comm, &prepared.bricks.brick, true);
+  const std::optional<DataSummary> summary = summarizeData(comm, &prepared.bricks.brick, false);
   if (summary) core::resolveDataDefaults(result.scene.volumes.front().transfer, summary->range[0], summary->range[1]);
 
   // Preprocess (macrocell grid, classification) and render my brick into

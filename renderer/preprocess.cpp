@@ -1,6 +1,10 @@
 #include "preprocess.h"
 
 #include <algorithm>
+#if defined(__AVX512BW__)
+#include <immintrin.h>
+#endif
+#include <cstring>
 #include <type_traits>
 #include <mutex>
 #include <vector>
@@ -54,6 +58,39 @@ void foldBounds(const T* __restrict srcMin, const T* __restrict srcMax, std::siz
     mx[i] = greater(mx[i], srcMax[i]);
   }
 }
+// The kSize + 1 rows of a macrocell row reduced in one pass: each element
+// is loaded once and stored once, where a fold row by row would load and
+// store the accumulators kSize times.
+template <typename T>
+void reduceRows5(const T* __restrict r0, const T* __restrict r1, const T* __restrict r2, const T* __restrict r3,
+                 const T* __restrict r4, std::size_t n, T* __restrict mn, T* __restrict mx) {
+  static_assert(kSize == 4, "reduceRows5 reduces kSize + 1 rows");
+  for (std::size_t i = 0; i < n; ++i) {
+    mn[i] = lesser(lesser(lesser(forMin(r0[i]), forMin(r1[i])), lesser(forMin(r2[i]), forMin(r3[i]))), forMin(r4[i]));
+    mx[i] = greater(greater(greater(forMax(r0[i]), forMax(r1[i])), greater(forMax(r2[i]), forMax(r3[i]))),
+                    forMax(r4[i]));
+  }
+}
+// Sliding bounds of kSize + 1 neighbours along x: w[x] covers [x, x + kSize],
+// for x < n - kSize. Vectorised (shifted loads), where a loop per
+// macrocell over its five elements is not.
+template <typename T>
+void windowBounds(const T* __restrict gmin, const T* __restrict gmax, std::size_t n, T* __restrict wmin,
+                  T* __restrict wmax) {
+  for (std::size_t x = 0; x + kSize < n; ++x) {
+    wmin[x] = lesser(lesser(lesser(gmin[x], gmin[x + 1]), lesser(gmin[x + 2], gmin[x + 3])), gmin[x + 4]);
+    wmax[x] = greater(greater(greater(gmax[x], gmax[x + 1]), greater(gmax[x + 2], gmax[x + 3])), gmax[x + 4]);
+  }
+}
+// out[i] = w[kSize * i], i < n: the windows that start on the macrocell lattice.
+template <typename T>
+void pickLattice(const T* __restrict wmin, const T* __restrict wmax, std::size_t n, T* __restrict omin,
+                 T* __restrict omax) {
+  for (std::size_t i = 0; i < n; ++i) {
+    omin[i] = wmin[std::size_t(kSize) * i];
+    omax[i] = wmax[std::size_t(kSize) * i];
+  }
+}
 template <typename T>
 std::uint64_t countNonFinite(const T* __restrict r, std::size_t n) {
   std::uint64_t bad = 0;
@@ -61,27 +98,63 @@ std::uint64_t countNonFinite(const T* __restrict r, std::size_t n) {
   return bad;
 }
 
-// Adds the fine keys of a row's finite values to `counts`. Two tables
-// taken in turn keep consecutive values from waiting on each other's
-// increment; and an integer row counts a block of kRunBlock equal values
-// (air, flat regions: most of a scan) with one addition, where one
-// increment after another of the same key would each wait for the last.
+// Whether the 64 bytes at `p` hold one integer value only: one compare
+// with AVX-512, else an OR of differences, which compilers vectorise
+// (a compare per element ORed as bool they do not: perf had that at one
+// instruction chain per voxel).
 template <typename T>
-void countRow(const T* __restrict r, std::size_t n, std::uint64_t* __restrict a, std::uint64_t* __restrict b) {
+inline bool blockIsFlat(const T* p) {
+  static_assert(std::is_integral_v<T>);
+#if defined(__AVX512BW__)
+  const __m512i v = _mm512_loadu_si512(p);
+  if constexpr (sizeof(T) == 1) return _mm512_cmpneq_epi8_mask(v, _mm512_set1_epi8(char(p[0]))) == 0;
+  else return _mm512_cmpneq_epi16_mask(v, _mm512_set1_epi16(short(p[0]))) == 0;
+#else
+  using U = std::make_unsigned_t<T>;
+  U differ = 0;
+  for (std::size_t k = 1; k < 64 / sizeof(T); ++k) differ |= U(U(p[k]) ^ U(p[0]));
+  return differ == 0;
+#endif
+}
+
+// Fine-count tables a row is counted into, taken in turn so that
+// consecutive values do not wait on each other's increment (neighbours
+// often share a value): four for 8-bit data (8 KB in all; eight measured
+// no faster), two for the others (65536 keys each).
+template <typename T> constexpr std::size_t kCountTables = sizeof(T) == 1 ? 4 : 2;
+template <typename T> constexpr std::size_t kTableKeys = std::size_t(1) << (sizeof(T) == 1 ? 8 : 16);  // fineKeyCount
+
+// Adds the fine keys of a row's finite values to the tables `t`
+// (kCountTables<T> of kTableKeys<T> each, one after the other). An integer
+// row counts a block of kRunBlock equal values (air, flat regions: much of
+// a scan) with one addition, where one increment after another of the
+// same key would each wait for the last; 8-bit data takes a changing
+// block's values eight at a time from one load.
+template <typename T>
+void countRow(const T* __restrict r, std::size_t n, std::uint64_t* __restrict t) {
+  constexpr std::size_t K = kTableKeys<T>;
+  std::uint64_t* __restrict a = t;
+  std::uint64_t* __restrict b = t + K;
   std::size_t i = 0;
   if constexpr (!std::is_floating_point_v<T>) {
     constexpr std::size_t kRunBlock = 64 / sizeof(T);
     for (; i + kRunBlock <= n; i += kRunBlock) {
       const T first = r[i];
-      unsigned differ = 0;  // an OR over the block: vectorised, no branch per voxel
-      for (std::size_t k = 1; k < kRunBlock; ++k) differ |= unsigned(r[i + k] != first);
-      if (!differ) {
+      if (blockIsFlat(r + i)) {
         a[fineKey(first)] += kRunBlock;
         continue;
       }
-      for (std::size_t k = 0; k < kRunBlock; k += 2) {
-        ++a[fineKey(r[i + k])];
-        ++b[fineKey(r[i + k + 1])];
+      if constexpr (sizeof(T) == 1) {
+        for (std::size_t k = 0; k < kRunBlock; k += 8) {
+          std::uint64_t w;
+          std::memcpy(&w, r + i + k, 8);  // little or big endian: each byte is counted once either way
+          for (std::size_t byte = 0; byte < 8; ++byte) ++t[byte % kCountTables<T> * K + ((w >> (8 * byte)) & 255)];
+        }
+      } else {
+        for (std::size_t k = 0; k < kRunBlock; k += 2) {
+          ++a[fineKey(r[i + k])];
+          ++b[fineKey(r[i + k + 1])];
+        }
       }
     }
   }
@@ -109,14 +182,25 @@ class SlabAccumulator {
         ex_(std::size_t(stored.extent(0))) {
     if (counted && !counted->empty()) {
       counted_ = *counted;
-      const std::size_t keys = std::size_t(1) << (sizeof(T) == 1 ? 8 : 16);  // fineKeyCount
-      countsA_.assign(keys, 0);
-      countsB_.assign(keys, 0);
+      counts_.assign(kCountTables<T> * kTableKeys<T>, 0);
     }
     groupMin_.resize(ex_);
     groupMax_.resize(ex_);
-    rangeMin_.assign(ex_, emptyMin<T>());
-    rangeMax_.assign(ex_, emptyMax<T>());
+    windowMin_.resize(ex_);
+    windowMax_.resize(ex_);
+    rangeMin_.assign(std::size_t(l_.count.x), emptyMin<T>());
+    rangeMax_.assign(std::size_t(l_.count.x), emptyMax<T>());
+    // Step: the macrocells along x whose node range lies whole in the
+    // stored row [whole0_, whole1_), the first one's node, and the nodes
+    // some macrocell covers.
+    const std::int64_t firstX = l_.first.x, cx = l_.count.x;
+    whole0_ = 0;
+    while (whole0_ < cx && (firstX + whole0_) * kSize < st_.lo.x) ++whole0_;
+    whole1_ = cx;
+    while (whole1_ > whole0_ && (firstX + whole1_ - 1) * kSize + kSize > st_.hi.x) --whole1_;
+    wholeAt_ = std::size_t(std::max<std::int64_t>(0, (firstX + whole0_) * kSize - st_.lo.x));
+    coveredLo_ = std::size_t(std::max(st_.lo.x, firstX * kSize) - st_.lo.x);
+    coveredHi_ = std::size_t(std::min(st_.hi.x, (firstX + cx) * kSize) - st_.lo.x);
     slabMin_.resize(std::size_t(l_.count.x * l_.count.y));
     slabMax_.resize(slabMin_.size());
   }
@@ -132,22 +216,36 @@ class SlabAccumulator {
     auto row = [&](std::int64_t y) { return slab + std::size_t(y - st_.lo.y) * ex_; };
 
     // Step: per macrocell row, reduce its node rows element by element,
-    // then along x per macrocell.
-    const std::int64_t cx = l_.count.x, firstX = l_.first.x, loX = st_.lo.x, hiX = st_.hi.x;
+    // then along x: sliding windows picked on the lattice for the
+    // macrocells of whole node ranges, one by one for the (at most two)
+    // clipped at the stored box's x ends.
+    const std::int64_t cx = l_.count.x;
     for (std::int64_t j = 0; j < l_.count.y; ++j) {
       const std::int64_t my = l_.first.y + j;
       const std::int64_t ya = std::max(st_.lo.y, my * kSize);
       const std::int64_t yb = std::min(st_.hi.y, my * kSize + kSize);
       T* gmin = groupMin_.data();
       T* gmax = groupMax_.data();
-      startRows(row(ya), ex_, gmin, gmax);
-      for (std::int64_t y = ya + 1; y <= yb; ++y) foldRow(row(y), ex_, gmin, gmax);
+      if (yb - ya == kSize) {
+        reduceRows5(row(ya), row(ya + 1), row(ya + 2), row(ya + 3), row(ya + 4), ex_, gmin, gmax);
+      } else {
+        startRows(row(ya), ex_, gmin, gmax);
+        for (std::int64_t y = ya + 1; y <= yb; ++y) foldRow(row(y), ex_, gmin, gmax);
+      }
       T* smin = slabMin_.data() + j * cx;
       T* smax = slabMax_.data() + j * cx;
+      if (whole1_ > whole0_) {
+        const std::size_t n = std::size_t(whole1_ - whole0_);
+        windowBounds(gmin + wholeAt_, gmax + wholeAt_, std::size_t(kSize) * n + 1, windowMin_.data(),
+                     windowMax_.data());
+        pickLattice(windowMin_.data(), windowMax_.data(), n, smin + whole0_, smax + whole0_);
+      }
       for (std::int64_t i = 0; i < cx; ++i) {
-        const std::int64_t mx = firstX + i;
-        const std::size_t xa = std::size_t(std::max(loX, mx * kSize) - loX);
-        const std::size_t xb = std::size_t(std::min(hiX, mx * kSize + kSize) - loX);
+        if (i == whole0_ && whole1_ > whole0_) i = whole1_;
+        if (i >= cx) break;
+        const std::int64_t mx = l_.first.x + i;
+        const std::size_t xa = std::size_t(std::max(st_.lo.x, mx * kSize) - st_.lo.x);
+        const std::size_t xb = std::size_t(std::min(st_.hi.x, mx * kSize + kSize) - st_.lo.x);
         T lo = gmin[xa], hi = gmax[xa];
         for (std::size_t x = xa + 1; x <= xb; ++x) {
           lo = lesser(lo, gmin[x]);
@@ -156,7 +254,17 @@ class SlabAccumulator {
         smin[i] = lo;
         smax[i] = hi;
       }
-      if (countRange) foldBounds(gmin, gmax, ex_, rangeMin_.data(), rangeMax_.data());
+      // The range: the macrocells' bounds cover the nodes from the first
+      // macrocell's to the last's; the columns outside, one by one.
+      if (countRange) {
+        foldBounds(smin, smax, std::size_t(cx), rangeMin_.data(), rangeMax_.data());
+        for (std::size_t x = 0; x < ex_; ++x) {
+          if (x == coveredLo_) x = coveredHi_ + 1;
+          if (x >= ex_) break;
+          rangeLo_ = lesser(rangeLo_, gmin[x]);
+          rangeHi_ = greater(rangeHi_, gmax[x]);
+        }
+      }
     }
 
     // Step: the range also covers ghost rows outside every macrocell row,
@@ -164,16 +272,21 @@ class SlabAccumulator {
     if (countRange) {
       const std::int64_t yLo = l_.first.y * kSize, yHi = (l_.first.y + l_.count.y) * kSize;
       for (std::int64_t y = st_.lo.y; y <= st_.hi.y; ++y) {
-        if (y < yLo || y > yHi) foldRow(row(y), ex_, rangeMin_.data(), rangeMax_.data());
+        if (y < yLo || y > yHi) {
+          const T* r = row(y);
+          for (std::size_t x = 0; x < ex_; ++x) {
+            rangeLo_ = lesser(rangeLo_, forMin(r[x]));
+            rangeHi_ = greater(rangeHi_, forMax(r[x]));
+          }
+        }
         if constexpr (std::is_floating_point_v<T>) nonFinite_ += countNonFinite(row(y), ex_);
       }
     }
 
     // Step: count the owned voxels' keys, each slab once (countRange).
-    if (countRange && !countsA_.empty() && z >= counted_.lo.z && z <= counted_.hi.z)
+    if (countRange && !counts_.empty() && z >= counted_.lo.z && z <= counted_.hi.z)
       for (std::int64_t y = counted_.lo.y; y <= counted_.hi.y; ++y)
-        countRow(row(y) + std::size_t(counted_.lo.x - st_.lo.x), std::size_t(counted_.extent(0)), countsA_.data(),
-                 countsB_.data());
+        countRow(row(y) + std::size_t(counted_.lo.x - st_.lo.x), std::size_t(counted_.extent(0)), counts_.data());
 
     // Step: widen the layers.
     if (into0) foldLayer(m0);
@@ -182,8 +295,8 @@ class SlabAccumulator {
 
   // The counted slabs' range; min > max if they hold no finite voxel.
   ValueRange range() const {
-    T lo = emptyMin<T>(), hi = emptyMax<T>();
-    for (std::size_t i = 0; i < ex_; ++i) {
+    T lo = rangeLo_, hi = rangeHi_;
+    for (std::size_t i = 0; i < rangeMin_.size(); ++i) {
       lo = lesser(lo, rangeMin_[i]);
       hi = greater(hi, rangeMax_[i]);
     }
@@ -192,7 +305,7 @@ class SlabAccumulator {
 
   // Adds the counted keys to `out` (sized fineKeyCount); nothing without a counted box.
   void addCounts(std::vector<std::uint64_t>& out) const {
-    for (std::size_t k = 0; k < countsA_.size(); ++k) out[k] += countsA_[k] + countsB_[k];
+    for (std::size_t k = 0; k < counts_.size(); ++k) out[k % kTableKeys<T>] += counts_[k];
   }
 
  private:
@@ -208,11 +321,16 @@ class SlabAccumulator {
   std::int64_t layerLo_, layerHi_;
   std::size_t ex_;
   std::vector<T> groupMin_, groupMax_;  // one macrocell row's node rows, reduced
-  std::vector<T> rangeMin_, rangeMax_;  // every counted row, reduced
+  std::vector<T> windowMin_, windowMax_;  // sliding bounds along x (windowBounds)
+  std::int64_t whole0_ = 0, whole1_ = 0;  // macrocells of whole node ranges along x
+  std::size_t wholeAt_ = 0;               // node of macrocell whole0_, in the stored row
+  std::size_t coveredLo_ = 0, coveredHi_ = 0;  // nodes some macrocell covers, in the stored row
+  std::vector<T> rangeMin_, rangeMax_;    // every counted slab's macrocell bounds, reduced
+  T rangeLo_ = emptyMin<T>(), rangeHi_ = emptyMax<T>();  // ... and its nodes outside every macrocell
   std::vector<T> slabMin_, slabMax_;    // this slab's 2-D macrocell bounds
   std::uint64_t nonFinite_ = 0;
-  NodeBox counted_;                                  // histogram box, when countsA_ is sized
-  std::vector<std::uint64_t> countsA_, countsB_;     // fine key counts, two tables (countRow)
+  NodeBox counted_;                     // histogram box, when counts_ is sized
+  std::vector<std::uint64_t> counts_;   // fine key counts, kCountTables<T> tables (countRow)
 };
 
 ValueRange mergeRanges(const ValueRange& a, const ValueRange& b) {

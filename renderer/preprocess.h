@@ -3,15 +3,18 @@
 //
 // The pass walks node slabs (one z each). Within a slab, the rows of each
 // macrocell row's node range (kSize + 1 rows) are reduced element by
-// element, which the compiler vectorises, and the reduced row is then
-// reduced along x once per macrocell: the separable min/max. The slab's
+// element in one pass, which the compiler vectorises, and the reduced row
+// then along x by sliding windows of kSize + 1 picked on the macrocell
+// lattice (vectorised too): the separable min/max. The value range is the
+// macrocells' bounds plus the ghost nodes outside every macrocell. The slab's
 // 2-D bounds then widen the (at most two) macrocell layers whose node range
 // holds the slab. A slab's few rows stay in cache while all of this
 // happens, so a reader can hand each slab over right after it lands and
 // the data is touched once (raw_reader.cpp). Float data skips NaN and Inf
 // in both range and bounds, and counts them. The same pass counts the
 // histogram's fine keys of the voxels a brick owns (value_histogram.h):
-// one table increment per owned voxel, nothing per ghost.
+// one table increment per owned voxel, one per 64 bytes of one value,
+// nothing per ghost.
 #pragma once
 
 #include <cstdint>

@@ -11,7 +11,12 @@
 # the columns are in bench/scale/README.md.
 #
 #   bench/scale/run.sh [--size N] [--ranks "1 2 4 8"] [--frames F] [--no-series] [--series-only]
-#                      [--decomposition kd|balanced|slabs] [BUILD_DIR]   (default: build, kd)
+#                      [--decomposition kd|balanced|slabs] [--summaries] [BUILD_DIR]   (default: build, kd)
+# --summaries adds, per rank count, runs with persistent brick summaries
+# (PVR_SUMMARY_CACHE=DATA/summaries, emptied first; io/brick_summary.h):
+# one that writes them (cache "sumfill"), then one that reads them (cache
+# "summaries": page cache and summaries warm). The cold and warm rows
+# never see a summary.
 # Environment: PVR_SCALE_DATA (data directory, outside the repository;
 # default /work/scale-data), PVR_SCALE_SERIES_SIZE (256), PVR_SCALE_STEPS
 # (50), PVR_SCALE_CACHEMEM (read-ahead budget in MB, 4096), PVR_SCALE_DROP
@@ -24,7 +29,7 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
-size=2048 ranks="1 2 4 8" frames=20 static=1 series=1 build=$root/build decomposition=kd
+size=2048 ranks="1 2 4 8" frames=20 static=1 series=1 build=$root/build decomposition=kd summaries=0
 while [ $# -gt 0 ]; do
   case $1 in
     --size) size=$2; shift 2 ;;
@@ -33,6 +38,7 @@ while [ $# -gt 0 ]; do
     --no-series) series=0; shift ;;
     --series-only) static=0; shift ;;
     --decomposition) decomposition=$2; shift 2 ;;
+    --summaries) summaries=1; shift ;;
     -*) echo "run.sh: unknown option $1" >&2; exit 2 ;;
     *) build=$1; shift ;;
   esac
@@ -52,6 +58,9 @@ done
 case "$data" in "$root"/*) echo "run.sh: PVR_SCALE_DATA must be outside the repository" >&2; exit 1 ;; esac
 mkdir -p "$data" "$out"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+unset PVR_SUMMARY_CACHE
+summary_dir=$data/summaries
+[ "$summaries" = 1 ] && rm -rf "$summary_dir"
 csv=$out/$tag.csv log=$out/$tag.log
 echo "kind,ranks,cache,voxels,wall_s,read_file_s,start,read,prep,dist,rend,comp,comm,send,write,frames,fps,rss_max_mb,rss_mb_per_rank" > "$csv"
 : > "$log"
@@ -177,6 +186,13 @@ if [ "$static" = 1 ]; then
     dropCache "$raw"
     batch "$n" cold "$cold_read" "$voxels" "$data/$stem.scene.json"
     batch "$n" warm "$warm_read" "$voxels" "$data/$stem.scene.json"
+    if [ "$summaries" = 1 ]; then
+      export PVR_SUMMARY_CACHE=$summary_dir
+      batch "$n" sumfill "$warm_read" "$voxels" "$data/$stem.scene.json"
+      batch "$n" summaries "$warm_read" "$voxels" "$data/$stem.scene.json"
+      unset PVR_SUMMARY_CACHE
+      rm -rf "$summary_dir"
+    fi
   done
 
   startPvrd
@@ -186,6 +202,17 @@ if [ "$static" = 1 ]; then
     session -kind pvrsh -cache warm -ranks "$n" -dataset "$stem.json" -frames "$frames" -readfile "$warm_read" -voxels "$voxels"
   done
   stopPvrd
+  if [ "$summaries" = 1 ]; then
+    export PVR_SUMMARY_CACHE=$summary_dir  # pvrd's mpirun and its ranks inherit it
+    startPvrd
+    for n in $ranks; do
+      session -kind pvrsh -cache sumfill -ranks "$n" -dataset "$stem.json" -frames "$frames" -readfile "$warm_read" -voxels "$voxels"
+      session -kind pvrsh -cache summaries -ranks "$n" -dataset "$stem.json" -frames "$frames" -readfile "$warm_read" -voxels "$voxels"
+      rm -rf "$summary_dir"
+    done
+    stopPvrd
+    unset PVR_SUMMARY_CACHE
+  fi
 fi
 
 if [ "$series" = 1 ]; then

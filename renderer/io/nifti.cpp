@@ -132,6 +132,7 @@ class ScaledSource final : public VolumeSource {
     return out;
   }
   std::string caveat() const override { return stored_->caveat(); }
+  void setFineCounts(bool on) override { stored_->setFineCounts(on); }
   std::string describe() const override {
     return stored_->describe() + " scaled to float32 (" + std::to_string(slope_) + " * v + " +
            std::to_string(inter_) + ")";

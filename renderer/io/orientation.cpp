@@ -76,6 +76,7 @@ class ReorientedSource final : public VolumeSource {
     return inner_->describe() + (o_.reorders() ? " (reoriented to its space)" : "");
   }
   std::string caveat() const override { return obliqueWarning(o_); }
+  void setFineCounts(bool on) override { inner_->setFineCounts(on); }
 
   Brick readBox(const NodeBox& owned, const NodeBox& stored) const override {
     // An oblique file on its own axes needs no reordering, only its caveat.

@@ -4,10 +4,12 @@
 #include <bit>
 #include <chrono>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include <unistd.h>
 
+#include "brick_summary.h"
 #include "byte_stream.h"
 #include "gzip_stream.h"
 #include "preprocess.h"
@@ -61,8 +63,9 @@ class RawVolumeSource final : public VolumeSource {
   ScalarType type() const override { return type_; }
   bool canReadPartially() const override { return layout_.encoding == RawEncoding::kRaw; }
   Brick readBox(const NodeBox& owned, const NodeBox& stored) const override {
-    return readRawBox(layout_, grid_, type_, owned, stored);
+    return readRawBox(layout_, grid_, type_, owned, stored, fineCounts_);
   }
+  void setFineCounts(bool on) override { fineCounts_ = on; }
   std::string describe() const override { return name_ + ": " + shapeText(grid_, type_); }
 
  private:
@@ -70,6 +73,7 @@ class RawVolumeSource final : public VolumeSource {
   GridGeometry grid_;
   ScalarType type_;
   RawLayout layout_;
+  bool fineCounts_ = true;
 };
 
 }  // namespace
@@ -104,7 +108,7 @@ std::unique_ptr<VolumeSource> openRawVolume(std::string name, const GridGeometry
 }
 
 Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType type,
-                 const NodeBox& owned, const NodeBox& stored) {
+                 const NodeBox& owned, const NodeBox& stored, bool fineCounts) {
   using Clock = std::chrono::steady_clock;
   auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   checkReadBoxes(layout.dataPath, grid, owned, stored);
@@ -136,8 +140,16 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
   // forward), bring each to host order and preprocess it while it is in
   // cache: the voxels are touched once.
   const bool swap = size > 1 && layout.bigEndian != (std::endian::native == std::endian::big);
+  // A summary of this brick kept from an earlier read of the same file
+  // (brick_summary.h) stands for the preprocessing: the slabs are only read.
+  BrickSummaryCache summaries(layout, grid, type, owned, stored);
+  auto preStart = Clock::now();
+  std::optional<Preprocessed> summary = summaries.load();
   const NodeBox counted = countedBox(owned, grid);
-  SlabPreprocessor pre(type, owned, stored, &counted);
+  std::optional<SlabPreprocessor> pre;
+  // A summary to keep is whole: it counts even when this read need not.
+  if (!summary) pre.emplace(type, owned, stored, fineCounts || summaries.enabled() ? &counted : nullptr);
+  const double summarySeconds = since(preStart);
   // The file bytes of the group of slabs starting at z0: from its first
   // run to the end of its last.
   auto groupOffset = [&](std::int64_t z0) {
@@ -192,16 +204,22 @@ Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType t
         }
       }
       brick.loadTimes().read += since(readStart);
-      const auto preStart = Clock::now();
+      const auto slabStart = Clock::now();
       if (swap) swapBytesInPlace(voxels + at, std::size_t(z1 - z0 + 1) * slabBytes / size, size);
-      pre.add(lent ? lent.get() + at : voxels + at, z0, z1);
-      brick.loadTimes().preprocess += since(preStart);
+      if (pre) pre->add(lent ? lent.get() + at : voxels + at, z0, z1);
+      brick.loadTimes().preprocess += since(slabStart);
     }
   });
-  const auto preStart = Clock::now();
-  Preprocessed result = pre.finish();
+  preStart = Clock::now();
+  Preprocessed result;
+  if (summary) {
+    result = std::move(*summary);
+  } else {
+    result = pre->finish();
+    summaries.store(result);
+  }
   brick.setPreprocessed(result.range, std::move(result.bounds), std::move(result.histogram));
-  brick.loadTimes().preprocess += since(preStart);
+  brick.loadTimes().preprocess += summarySeconds + since(preStart);
   return brick;
 }
 

@@ -66,7 +66,10 @@ std::unique_ptr<VolumeSource> openRawVolume(std::string name, const GridGeometry
 // Contiguous runs are coalesced: whole rows into a slab, whole slabs into
 // groups of about a megabyte. No buffer besides the brick. Fills
 // brick.loadTimes(): seconds in I/O calls and in the fused preprocessing.
+// Without `fineCounts` the brick carries no fine histogram, unless summaries
+// are kept (io/brick_summary.h): a summary is whole, so the read that
+// writes it counts, and one that takes it has the counts.
 Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType type,
-                 const NodeBox& owned, const NodeBox& stored);
+                 const NodeBox& owned, const NodeBox& stored, bool fineCounts = true);
 
 }  // namespace pvr::core

@@ -70,6 +70,9 @@ class SeriesSource final : public VolumeSource {
   std::string describe() const override {
     return name_ + ": " + std::to_string(steps_.size()) + " steps of " + shapeText(grid(), type());
   }
+  void setFineCounts(bool on) override {
+    for (SeriesStep& s : steps_) s.volume->setFineCounts(on);
+  }
   // The steps share step 0's grid, so they share its orientation too.
   std::string caveat() const override { return steps_[0].volume->caveat(); }
 

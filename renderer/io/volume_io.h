@@ -37,6 +37,14 @@ class VolumeSource {
 
   Brick readAll() const { return readBox(grid().allNodes(), grid().allNodes()); }
 
+  // Whether readBox also counts the histogram's fine keys
+  // (Brick::fineHistogram, value_histogram.h) where the reader fuses them
+  // into the read (raw data); on by default. Off for a caller that never
+  // reports a histogram (pvr-node --batch): counting is most of the
+  // preprocessing of a brick that is not air. Sources over other sources
+  // pass it on.
+  virtual void setFineCounts(bool /*on*/) {}
+
   // A time series is steps() volumes on one grid and scalar type: step(k)
   // (0-based) is the k-th, stepTime(k) its time. A single volume is a series
   // of one step, itself. readBox of a series reads its step 0.

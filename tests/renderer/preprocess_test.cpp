@@ -355,6 +355,73 @@ TEST_CASE("fine counts of flat runs, runs broken by one voxel and changing value
   }
 }
 
+TEST_CASE("rows wide enough for the vector loops: bounds, range and fine counts equal brute force", "[preprocess]") {
+  // Rows of 263 nodes run the sliding-window and 64-byte loops through
+  // their vector bodies and remainders; boxes off the macrocell lattice
+  // clip a macrocell at either x end. Values: flat runs that cross block
+  // edges, runs broken by one voxel, random values (float: NaN and Inf).
+  const GridGeometry grid = gridOf({263, 11, 9});
+  const NodeBox owned[] = {grid.allNodes(), {{5, 2, 1}, {201, 9, 7}}, {{130, 0, 4}, {262, 10, 8}}};
+  std::uint32_t seed = 40;
+  for (ScalarType type : kTypes)
+    for (const NodeBox& own : owned)
+      for (int ghost : {0, 1, 3}) {
+        CAPTURE(scalarName(type), toString(own), ghost);
+        Brick b(grid, type, own, own.grown(ghost).intersect(grid.allNodes()));
+        const NodeBox& st = b.stored();
+        std::mt19937 rng(seed++);
+        dispatchScalar(type, [&](auto tag) {
+          using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+          const double lo = double(std::numeric_limits<T>::lowest()), hi = double(std::numeric_limits<T>::max());
+          auto any = [&] {
+            if constexpr (std::is_floating_point_v<T>) return T(std::uniform_real_distribution<float>(-1e3f, 1e3f)(rng));
+            else return T(std::uniform_int_distribution<long>(long(lo), long(hi))(rng));
+          };
+          T* v = b.as<T>();
+          for (std::int64_t z = st.lo.z; z <= st.hi.z; ++z)
+            for (std::int64_t y = st.lo.y; y <= st.hi.y; ++y) {
+              T run = any();
+              for (std::int64_t x = st.lo.x; x <= st.hi.x; ++x) {
+                if (x % 71 == 0) run = any();                   // flat runs of 71
+                T value = (y + z) % 3 == 0 ? any() : run;       // or changing throughout
+                if ((y + z) % 3 == 1 && x % 97 == 5) value = any();  // one voxel breaks a run
+                if constexpr (std::is_floating_point_v<T>) {
+                  if (x % 53 == 7) value = std::numeric_limits<T>::quiet_NaN();
+                  if (x % 89 == 3) value = (y & 1) ? std::numeric_limits<T>::infinity() : -std::numeric_limits<T>::infinity();
+                }
+                v[b.linearIndex({x, y, z})] = value;
+              }
+            }
+          b.updateValueRange();
+          const std::byte* voxels = std::as_const(b).bytes();
+          REQUIRE(b.macrocellBounds());
+          checkBoundsAgainstBruteForce(b, *b.macrocellBounds());
+          checkRange(b.valueRange(), bruteForceRange(b));
+
+          std::vector<std::uint64_t> expected(fineKeyCount(type), 0);
+          const NodeBox counted = countedBox(own, grid);
+          for (std::int64_t z = counted.lo.z; z <= counted.hi.z; ++z)
+            for (std::int64_t y = counted.lo.y; y <= counted.hi.y; ++y)
+              for (std::int64_t x = counted.lo.x; x <= counted.hi.x; ++x) {
+                const T value = v[b.linearIndex({x, y, z})];
+                if (std::isfinite(double(value))) ++expected[fineKey(value)];
+              }
+          REQUIRE(b.fineHistogram());
+          CHECK(b.fineHistogram()->counts == expected);
+
+          // Streamed slab by slab, as the raw reader does: the same.
+          SlabPreprocessor streamed(type, own, st, &counted);
+          const std::size_t slabBytes = std::size_t(st.extent(0) * st.extent(1)) * sizeof(T);
+          for (std::int64_t z = st.lo.z; z <= st.hi.z; ++z)
+            streamed.add(voxels + std::size_t(z - st.lo.z) * slabBytes, z, z);
+          const Preprocessed s = streamed.finish();
+          CHECK(sameBounds(*s.bounds, *b.macrocellBounds()));
+          checkRange(s.range, b.valueRange());
+          CHECK(s.histogram->counts == expected);
+        });
+      }
+}
+
 TEST_CASE("content counts equal brute force for every scalar type, single-threaded and on a pool", "[preprocess]") {
   ThreadPool pool(2);
   std::uint32_t seed = 100;
@@ -416,8 +483,21 @@ TEST_CASE("the raw reader's fused preprocessing equals reading, then preprocessi
           REQUIRE(twoPass.macrocellBounds());
           CHECK(sameBounds(*fused.macrocellBounds(), *twoPass.macrocellBounds()));
           checkRange(fused.valueRange(), twoPass.valueRange());
+          REQUIRE(fused.fineHistogram());
+          REQUIRE(twoPass.fineHistogram());
+          CHECK(fused.fineHistogram()->counts == twoPass.fineHistogram()->counts);
           CHECK(fused.loadTimes().read > 0);
           CHECK(fused.loadTimes().preprocess > 0);
+
+          // Told to count nothing (pvr-node --batch): the same bounds and
+          // range, no histogram.
+          source->setFineCounts(false);
+          const Brick uncounted = source->readBox(owned, stored);
+          source->setFineCounts(true);
+          CHECK_FALSE(uncounted.fineHistogram());
+          REQUIRE(uncounted.macrocellBounds());
+          CHECK(sameBounds(*uncounted.macrocellBounds(), *twoPass.macrocellBounds()));
+          checkRange(uncounted.valueRange(), twoPass.valueRange());
         }
     }
 }
