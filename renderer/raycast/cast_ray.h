@@ -16,6 +16,7 @@ namespace kernel {
 template <typename T, bool kShaded, bool kPreintegrated>
 inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t start,
                       std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
+  if (start >= exit) return false;  // the batched kernel did them all: no window to set up
   const T* v = static_cast<const T*>(p.voxels);
   const float o0 = float(ray.origin[0]), o1 = float(ray.origin[1]), o2 = float(ray.origin[2]);
   const float d0 = float(ray.step[0]), d1 = float(ray.step[1]), d2 = float(ray.step[2]);
