@@ -20,6 +20,7 @@
 
 #include "kernel.h"
 #include "preint_lanes.h"
+#include "preint_lighting.h"
 
 namespace pvr::core::kernel {
 
@@ -287,12 +288,15 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     const preint::Ends8 backs = preint::endsAt(p.preint, node);
     const preint::Ends8 fronts = preint::fronts(before, backs);
     const preint::Segments8 seg = preint::segments<kShaded>(fronts, backs, p.stepLength);
-    alignas(32) float r[8], g[8], b[8], a[8], centre[8];
+    alignas(32) float r[8], g[8], b[8], a[8], centre[8], spread[8];
     _mm256_store_ps(r, _mm512_maskz_cvtpd_ps(preint::kAll, seg.r));
     _mm256_store_ps(g, _mm512_maskz_cvtpd_ps(preint::kAll, seg.g));
     _mm256_store_ps(b, _mm512_maskz_cvtpd_ps(preint::kAll, seg.b));
     _mm256_store_ps(a, _mm512_maskz_cvtpd_ps(preint::kAll, seg.a));
-    if constexpr (kShaded) _mm256_store_ps(centre, _mm512_maskz_cvtpd_ps(preint::kAll, seg.centre));
+    if constexpr (kShaded) {
+      _mm256_store_ps(centre, _mm512_maskz_cvtpd_ps(preint::kAll, seg.centre));
+      _mm256_store_ps(spread, _mm512_maskz_cvtpd_ps(preint::kAll, seg.spread));
+    }
     alignas(64) double frontX[8], backX[8];
     if (seg.opaque) {
       _mm512_store_pd(backX, backs.x);
@@ -304,17 +308,14 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     for (; lanes; lanes &= lanes - 1) {
       const int lane = __builtin_ctz(lanes);
       Rgba c{r[lane], g[lane], b[lane], a[lane]};
-      float middle = 0.5f;  // opaque segments are lit at their middle (segment())
+      float middle = 0.5f, around = 0.0f;  // opaque segments are lit at their middle (segment())
       if (seg.opaque & (1u << lane)) {
         c = preint::opaqueSegment(p.preint, frontX[lane], backX[lane]);
       } else if constexpr (kShaded) {
         middle = centre[lane];
+        around = spread[lane];
       }
-      if constexpr (kShaded) {
-        const float t = float(s + lane) + middle;
-        c = shade(v, p, ray, float(ray.origin[0]) + t * float(ray.step[0]),
-                  float(ray.origin[1]) + t * float(ray.step[1]), float(ray.origin[2]) + t * float(ray.step[2]), c);
-      }
+      if constexpr (kShaded) c = shadeSegment(v, p, ray, float(s + lane), 1.0f, middle, around, c);
       acc.addBehind(c);
     }
     }
@@ -323,16 +324,14 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     _mm256_store_ps(back, node);
     for (int lane = 0; lane < 8; ++lane) {
       const preint::End backEnd = segmentEnd<T>(p, back[lane]);
-      float centre = 0.5f;
+      float centre = 0.5f, spread = 0.0f;
       Rgba c = finite<T>(raw[lane]) && finite<T>(raw[lane + 1])
-                   ? preint::segment(p.preint, frontEnd, backEnd, p.stepLength, &centre)
+                   ? preint::segment(p.preint, frontEnd, backEnd, p.stepLength, &centre, &spread)
                    : Rgba{};
       frontEnd = backEnd;
       if constexpr (kShaded) {
         if (!(c.a > 0)) continue;
-        const float t = float(s + lane) + centre;
-        c = shade(v, p, ray, float(ray.origin[0]) + t * float(ray.step[0]),
-                  float(ray.origin[1]) + t * float(ray.step[1]), float(ray.origin[2]) + t * float(ray.step[2]), c);
+        c = shadeSegment(v, p, ray, float(s + lane), 1.0f, centre, spread, c);
       }
       acc.addBehind(c);
     }

@@ -164,13 +164,14 @@ inline Ends8 broadcast(const End& end) {
 }
 
 // Eight segments from `f` to `b`, each `length` world units: segment()'s
-// premultiplied colour and opacity and, with kCentre, where to light it.
+// premultiplied colour and opacity and, with kCentre, where to light it
+// (centre and spread).
 // Lanes that segment() would make opaque are flagged in `opaque` and left
 // empty here (their colour: opaqueSegment()); so are lanes with no
 // extinction.
 struct Segments8 {
   __m512d r, g, b, a;
-  __m512d centre;
+  __m512d centre, spread;
   __mmask8 opaque;
 };
 
@@ -212,11 +213,18 @@ template <bool kCentre>
     __m512d at = _mm512_mask_blend_pd(wide, quotient, _mm512_mul_pd(_mm512_sub_pd(quotient, f.x), inv));
     at = _mm512_mask_blend_pd(wide | _mm512_cmp_pd_mask(sum, zero, _CMP_GT_OQ), half, at);
     const __m512d one = _mm512_set1_pd(1.0);
-    const __m512d thick = _mm512_sub_pd(
-        _mm512_sub_pd(reciprocal(depth), _mm512_mul_pd(_mm512_sub_pd(one, alpha), reciprocal(alpha))), half);
+    const __m512d inverseDepth = reciprocal(depth), inverseAlpha = reciprocal(alpha);
+    const __m512d transmitted = _mm512_mul_pd(_mm512_sub_pd(one, alpha), inverseAlpha);  // 1 / (e^D - 1)
+    const __m512d thick = _mm512_sub_pd(_mm512_sub_pd(inverseDepth, transmitted), half);
     const __mmask8 thin = _mm512_cmp_pd_mask(depth, _mm512_set1_pd(1e-3), _CMP_LT_OQ);
     at = _mm512_add_pd(at, _mm512_mask_blend_pd(thin, thick, _mm512_mul_pd(depth, _mm512_set1_pd(-1.0 / 12))));
-    s.centre = _mm512_maskz_min_pd(kAll, _mm512_maskz_max_pd(kAll, at, zero), _mm512_set1_pd(1.0));
+    s.centre = _mm512_maskz_min_pd(kAll, _mm512_maskz_max_pd(kAll, at, zero), one);
+    // emissionVariance(), and its square root.
+    const __m512d variance = _mm512_mask_blend_pd(
+        _mm512_cmp_pd_mask(depth, _mm512_set1_pd(1e-2), _CMP_LT_OQ),
+        _mm512_fmsub_pd(inverseDepth, inverseDepth, _mm512_mul_pd(transmitted, inverseAlpha)),
+        _mm512_fnmadd_pd(_mm512_mul_pd(depth, depth), _mm512_set1_pd(1.0 / 720), _mm512_set1_pd(1.0 / 12)));
+    s.spread = _mm512_maskz_sqrt_pd(kAll, _mm512_maskz_max_pd(kAll, variance, zero));
   }
   return s;
 }
