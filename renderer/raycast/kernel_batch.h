@@ -224,17 +224,22 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     lo[1] = firstLo[2];
     hi[1] = firstHi[2];
   }
+  // On to the next batch, `count` segments done: the two samples before
+  // its first node carried over.
+  auto advance = [&](std::int64_t s, int count) __attribute__((always_inline)) {
+    raw[0] = raw[8];
+    raw[1] = raw[9];
+    lo[1] = lo[9];
+    hi[1] = hi[9];
+    samples += std::uint64_t(count);
+    start = s + count;
+  };
 #ifdef PVR_HAVE_PREINT_LANES
-  // Lane 7 of `before`: the next segment's front end, at node frontNode;
-  // after a batch of empty cells it is looked up again only when needed.
+  // Lane 7 of `before`: the next segment's front end, at node frontNode
+  // (stale after a batch of empty cells).
   preint::Ends8 before = preint::broadcast(frontEnd);
   float frontNode = frontScalar;
   bool frontStale = false;
-  const __m256 tableScale = _mm256_set1_ps(p.preint.scale), tableOffset = _mm256_set1_ps(p.preint.offset);
-  const float tableLast = float(p.preint.entries - 1);
-  auto cellOf = [&](float x) __attribute__((always_inline)) {
-    return std::min(int(std::clamp(x, 0.0f, tableLast)), p.preint.entries - 2);
-  };
 #endif
   for (std::int64_t s = start; s + kFullBatchesOnly < exit; s += 8) {
     __m256 lo8, hi8;
@@ -259,29 +264,16 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
       node = _mm256_and_ps(node, finite8(node));
       valid &= unsigned(_mm256_movemask_ps(_mm256_and_ps(finite8(before8), finite8(at))));
     }
-    // No segment of the batch integrates anything when every cell its
-    // nodes lie in is empty (one cell of margin for rounding): skip the
-    // table, count the samples.
-    bool empty;
-    {
-      const __m256 front = _mm256_set1_ps(frontNode);
-      __m256 x = _mm256_fmadd_ps(_mm256_min_ps(node, front), tableScale, tableOffset);  // scale >= 0
-      __m256 y = _mm256_fmadd_ps(_mm256_max_ps(node, front), tableScale, tableOffset);
-      x = _mm256_min_ps(x, _mm256_permute2f128_ps(x, x, 1));
-      y = _mm256_max_ps(y, _mm256_permute2f128_ps(y, y, 1));
-      x = _mm256_min_ps(x, _mm256_shuffle_ps(x, x, 0x4e));
-      y = _mm256_max_ps(y, _mm256_shuffle_ps(y, y, 0x4e));
-      const __m256 lo8x = _mm256_min_ps(x, _mm256_shuffle_ps(x, x, 0xb1));
-      const __m256 hi8x = _mm256_max_ps(y, _mm256_shuffle_ps(y, y, 0xb1));
-      const int first = std::max(cellOf(_mm256_cvtss_f32(lo8x)) - 1, 0);
-      const int last = std::min(cellOf(_mm256_cvtss_f32(hi8x)) + 1, p.preint.entries - 2);
-      empty = p.preint.visibleBelow[last + 1] == p.preint.visibleBelow[first];
-    }
+    // A batch whose nodes all lie in empty cells integrates nothing: skip
+    // the table, count the samples; the front end is looked up again only
+    // when a batch needs it.
     const float nextFront = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(node, _mm256_set1_epi32(7)));
-    if (empty) {
+    if (preint::allEmpty(p.preint, node, frontNode)) {
       frontStale = true;
       frontNode = nextFront;
-    } else {
+      advance(s, count);
+      continue;
+    }
     if (frontStale) before = preint::broadcast(preint::endAt(p.preint, frontNode));
     frontStale = false;
     frontNode = nextFront;
@@ -318,7 +310,6 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
       if constexpr (kShaded) c = shadeSegment(v, p, ray, float(s + lane), 1.0f, middle, around, c);
       acc.addBehind(c);
     }
-    }
 #else
     alignas(32) float back[8];
     _mm256_store_ps(back, node);
@@ -336,12 +327,7 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
       acc.addBehind(c);
     }
 #endif
-    raw[0] = raw[8];
-    raw[1] = raw[9];
-    lo[1] = lo[9];
-    hi[1] = hi[9];
-    samples += std::uint64_t(count);
-    start = s + count;
+    advance(s, count);
     if (acc.a >= p.earlyTermination) return true;
   }
   return false;

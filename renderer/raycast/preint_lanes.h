@@ -16,6 +16,7 @@
 
 #include <immintrin.h>
 
+#include <algorithm>
 #include <cstdint>
 
 #include "../preintegration.h"
@@ -96,6 +97,29 @@ struct Ends8 {
   e.opaque = point(row1[6], row1[7]);
   e.O = _mm512_fmadd_pd(beyond, e.opaque, _mm512_add_pd(row0[7], partial(row1[6], row1[7])));
   return e;
+}
+
+// True when the eight scalars and `front` all lie in empty cells
+// (visibleBelow), with a cell of margin for the float rounding of their
+// table coordinates: no segment between them integrates anything.
+[[gnu::always_inline]] inline bool allEmpty(const PreintegralTables& t, __m256 scalar, float front) {
+  const __m256 scale = _mm256_set1_ps(t.scale), offset = _mm256_set1_ps(t.offset), f = _mm256_set1_ps(front);
+  // Least and greatest table coordinate (scale >= 0), in every lane.
+  __m256 lo = _mm256_fmadd_ps(_mm256_min_ps(scalar, f), scale, offset);
+  __m256 hi = _mm256_fmadd_ps(_mm256_max_ps(scalar, f), scale, offset);
+  lo = _mm256_min_ps(lo, _mm256_permute2f128_ps(lo, lo, 1));
+  hi = _mm256_max_ps(hi, _mm256_permute2f128_ps(hi, hi, 1));
+  lo = _mm256_min_ps(lo, _mm256_shuffle_ps(lo, lo, 0x4e));
+  hi = _mm256_max_ps(hi, _mm256_shuffle_ps(hi, hi, 0x4e));
+  lo = _mm256_min_ps(lo, _mm256_shuffle_ps(lo, lo, 0xb1));
+  hi = _mm256_max_ps(hi, _mm256_shuffle_ps(hi, hi, 0xb1));
+  const float last = float(t.entries - 1);
+  auto cell = [&](float x) __attribute__((always_inline)) {
+    return std::min(int(std::clamp(x, 0.0f, last)), t.entries - 2);
+  };
+  const int first = std::max(cell(_mm256_cvtss_f32(lo)) - 1, 0);
+  const int final = std::min(cell(_mm256_cvtss_f32(hi)) + 1, t.entries - 2);
+  return t.visibleBelow[final + 1] == t.visibleBelow[first];
 }
 
 // The eight ends before these: lane 0 from lane 7 of `before`, lane j from
