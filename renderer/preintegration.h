@@ -21,28 +21,42 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include "image.h"
 
 namespace pvr::core {
 
-// One node of the integral table (per world unit and table coordinate).
-struct PreintegralNode {
-  double tau;     // extinction at the node; 0 where the node is opaque
-  double k[3];    // c tau, linear colour times extinction (0 where opaque)
-  double T;       // integral of tau from node 0 to this node
+// One cell of the integral table, [i, i + 1] in table coordinates, across
+// which the transfer function is linear: the values at node i and their
+// changes to node i + 1, per world unit and table coordinate. Two 64-byte
+// rows, so that the batched kernel loads a cell as two vectors and
+// transposes eight of them into one vector per field (preint_lanes.h).
+struct alignas(64) PreintegralCell {
+  // Row 0: extinction and the cumulative integrals.
+  double tau;     // extinction at node i; 0 where the node is opaque
+  double dtau;    // at node i + 1 minus at node i
+  double T;       // integral of tau from node 0 to node i
   double M;       // integral of x tau from node 0 (x: table coordinate), for the centroid
   double K[3];    // integral of c tau from node 0
-  double opaque;  // 1 where the opacity is 1, else 0
   double O;       // integral of `opaque` from node 0
+  // Row 1: colour and opacity, and their changes across the cell.
+  double k[3];    // c tau, linear colour times extinction (0 where opaque)
+  double dk[3];
+  double opaque;  // 1 where the opacity is 1, else 0
+  double dopaque;
 };
+static_assert(sizeof(PreintegralCell) == 128 && offsetof(PreintegralCell, k) == 64);
 
 // Where the pre-integration's tables are, for the kernels.
 struct PreintegralTables {
-  const PreintegralNode* nodes = nullptr;  // `entries` nodes
+  const PreintegralCell* cells = nullptr;  // `entries` cells (the last one: its node only)
   const Rgba* opaqueColour = nullptr;      // [2 * entries]: per node, the colour of the nearest
                                            // opaque node at or below it, then at or above it
+  const std::uint32_t* visibleBelow = nullptr;  // [entries]: cells below cell i with extinction or
+                                               // opacity 1 at either node (the batched kernel's
+                                               // test for a batch of empty segments)
   int entries = 0;
   float scale = 0, offset = 0;             // table coordinate = scalar * scale + offset
 };
@@ -69,33 +83,31 @@ struct End {
   const double xc = std::clamp(e.x, 0.0, last);
   const int i = std::min(int(xc), t.entries - 2);
   const double w = xc - double(i), beyond = e.x - xc;
-  const PreintegralNode& a = t.nodes[i];
-  const PreintegralNode& b = t.nodes[i + 1];
+  const PreintegralCell& a = t.cells[i];
   // Integral over [i, i + w] of a linear f: w * (f_a + w/2 (f_b - f_a)).
-  auto point = [w](double fa, double fb) __attribute__((always_inline)) { return fa + w * (fb - fa); };
-  auto partial = [w](double fa, double fb) __attribute__((always_inline)) {
-    return w * (fa + 0.5 * w * (fb - fa));
+  auto point = [w](double fa, double df) __attribute__((always_inline)) { return fa + w * df; };
+  auto partial = [w](double fa, double df) __attribute__((always_inline)) {
+    return w * (fa + 0.5 * w * df);
   };
-  e.tau = point(a.tau, b.tau);
-  e.T = a.T + partial(a.tau, b.tau) + beyond * e.tau;
+  e.tau = point(a.tau, a.dtau);
+  e.T = a.T + partial(a.tau, a.dtau) + beyond * e.tau;
   // Integral over [i, i + w] of (i + u) tau(u), tau linear; beyond, tau constant.
-  const double dtau = b.tau - a.tau;
-  e.M = a.M + double(i) * partial(a.tau, b.tau) + w * w * (0.5 * a.tau + w * dtau / 3.0) +
+  e.M = a.M + double(i) * partial(a.tau, a.dtau) + w * w * (0.5 * a.tau + w * a.dtau * (1.0 / 3)) +
         0.5 * e.tau * beyond * (e.x + xc);
   for (int c = 0; c < 3; ++c) {
-    e.k[c] = point(a.k[c], b.k[c]);
-    e.K[c] = a.K[c] + partial(a.k[c], b.k[c]) + beyond * e.k[c];
+    e.k[c] = point(a.k[c], a.dk[c]);
+    e.K[c] = a.K[c] + partial(a.k[c], a.dk[c]) + beyond * e.k[c];
   }
-  e.opaque = point(a.opaque, b.opaque);
-  e.O = a.O + partial(a.opaque, b.opaque) + beyond * e.opaque;
+  e.opaque = point(a.opaque, a.dopaque);
+  e.O = a.O + partial(a.opaque, a.dopaque) + beyond * e.opaque;
   return e;
 }
 
-// The colour of the first opaque scalar met going from `front` towards `back`.
-[[gnu::noinline, gnu::cold]] inline Rgba opaqueSegment(const PreintegralTables& t, const End& front,
-                                                        const End& back) {
-  const double xc = std::clamp(front.x, 0.0, double(t.entries - 1));
-  const bool up = back.x >= front.x;
+// The colour of the first opaque scalar met going from table coordinate
+// `front` towards `back`.
+[[gnu::noinline, gnu::cold]] inline Rgba opaqueSegment(const PreintegralTables& t, double front, double back) {
+  const double xc = std::clamp(front, 0.0, double(t.entries - 1));
+  const bool up = back >= front;
   const std::size_t below = 2 * std::size_t(std::floor(xc)), above = 2 * std::size_t(std::ceil(xc)) + 1;
   // The opaque node ahead of the front; none ahead: the one in the front's own cell.
   Rgba c = t.opaqueColour[up ? above : below];
@@ -104,14 +116,32 @@ struct End {
   return c;
 }
 
+// Where a segment of optical depth `depth` and opacity `alpha` (exactly
+// 1 - exp(-depth)) emits, in fractions of its length, if it were
+// homogeneous: the variance of t e^(-depth t) over [0, 1],
+// 1/D^2 - (1 - alpha)/alpha^2, and 1/12 as depth goes to 0.
+inline double emissionVariance(double depth, double alpha) {
+  return depth < 1e-2 ? 1.0 / 12 - depth * depth / 720 : 1 / (depth * depth) - (1 - alpha) / (alpha * alpha);
+}
+
 // The segment from `front` to `back`, `length` world units long:
-// premultiplied colour and opacity.
+// premultiplied colour and opacity. `centre` and `spread` (if given) get
+// where in the segment (0: front, 1: back) to light it: the two points
+// centre -+ spread, the centroid of its emission -+ the emission's
+// standard deviation, are the Gauss rule for lighting that varies along
+// the segment (exact to second order; lighting at the centroid alone is
+// exact to first order, and its error dominated pre-integration's on
+// shaded scenes: bench/results/preintegration.txt).
 [[gnu::always_inline]] inline Rgba segment(const PreintegralTables& t, const End& front,
-                                           const End& back, double length, float* centre = nullptr) {
+                                           const End& back, double length, float* centre = nullptr,
+                                           float* spread = nullptr) {
   const double dx = back.x - front.x;
   const bool wide = std::abs(dx) > kMinSpan;
-  if ((wide && back.O != front.O) || front.opaque > 0 || back.opaque > 0)
-    return opaqueSegment(t, front, back);
+  if ((wide && back.O != front.O) || front.opaque > 0 || back.opaque > 0) {
+    if (centre) *centre = 0.5f;  // lit at its middle
+    if (spread) *spread = 0.0f;
+    return opaqueSegment(t, front.x, back.x);
+  }
   double tau, k[3];
   if (wide) {
     const double inv = 1.0 / dx;
@@ -139,6 +169,7 @@ struct End {
     at += depth < 1e-3 ? -depth / 12 : 1 / depth - 1 / std::expm1(depth) - 0.5;
     *centre = float(std::clamp(at, 0.0, 1.0));
   }
+  if (spread) *spread = float(std::sqrt(std::max(emissionVariance(depth, alpha), 0.0)));
   const double w = alpha / tau;  // mean colour c = k / tau, times alpha
   return {float(k[0] * w), float(k[1] * w), float(k[2] * w), float(alpha)};
 }

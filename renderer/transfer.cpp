@@ -108,46 +108,62 @@ PreintegratedTable::PreintegratedTable(const TransferFunctionSpec& tf) {
   // Table coordinates per world scalar unit are folded into the integrals:
   // T and K are integrals over the table coordinate, and so is the
   // segment's difference quotient (preintegration.h).
-  nodes_.resize(n);
+  cells_.resize(n);
   opaqueColour_.resize(2 * std::size_t(n));
   for (int i = 0; i < n; ++i) {
     const Medium m = evaluateMedium(tf, domain.scalar(i));
-    PreintegralNode& node = nodes_[i];
+    PreintegralCell& cell = cells_[i];
     // Opacity 1 is kept out of the sums (its extinction is infinite); the
     // colour an opaque segment shows is recorded apart below.
     const bool opaque = m.tau >= 1e30;
-    node.tau = opaque ? 0.0 : m.tau;
+    cell.tau = opaque ? 0.0 : m.tau;
     const double c[3] = {m.r, m.g, m.b};
-    for (int k = 0; k < 3; ++k) node.k[k] = node.tau * c[k];
-    node.opaque = opaque ? 1.0 : 0.0;
+    for (int k = 0; k < 3; ++k) cell.k[k] = cell.tau * c[k];
+    cell.opaque = opaque ? 1.0 : 0.0;
     opaqueColour_[2 * std::size_t(i)] = opaqueColour_[2 * std::size_t(i) + 1] =
         opaque ? Rgba{float(m.r), float(m.g), float(m.b), 1.0f} : Rgba{};
   }
-  // Cumulative integrals of the piecewise-linear node values (trapezoids).
-  nodes_[0].T = nodes_[0].M = nodes_[0].O = 0;
-  for (int k = 0; k < 3; ++k) nodes_[0].K[k] = 0;
+  // Changes across each cell (none beyond the last node), and cumulative
+  // integrals of the piecewise-linear node values (trapezoids).
+  for (int i = 0; i < n; ++i) {
+    PreintegralCell& a = cells_[i];
+    const PreintegralCell& b = cells_[std::min(i + 1, n - 1)];
+    a.dtau = b.tau - a.tau;
+    for (int k = 0; k < 3; ++k) a.dk[k] = b.k[k] - a.k[k];
+    a.dopaque = b.opaque - a.opaque;
+  }
+  cells_[0].T = cells_[0].M = cells_[0].O = 0;
+  for (int k = 0; k < 3; ++k) cells_[0].K[k] = 0;
   for (int i = 1; i < n; ++i) {
-    const PreintegralNode& a = nodes_[i - 1];
-    PreintegralNode& b = nodes_[i];
+    const PreintegralCell& a = cells_[i - 1];
+    PreintegralCell& b = cells_[i];
     b.T = a.T + 0.5 * (a.tau + b.tau);
     // Integral over [i - 1, i] of x tau(x), tau linear: (i - 1) (a + b) / 2 + (a + 2 b) / 6.
     b.M = a.M + double(i - 1) * 0.5 * (a.tau + b.tau) + (a.tau + 2 * b.tau) / 6.0;
     for (int k = 0; k < 3; ++k) b.K[k] = a.K[k] + 0.5 * (a.k[k] + b.k[k]);
     b.O = a.O + 0.5 * (a.opaque + b.opaque);
   }
+  // Cells that are not empty, counted from the first.
+  visibleBelow_.assign(std::size_t(n), 0);
+  for (int i = 1; i < n; ++i) {
+    const PreintegralCell &a = cells_[i - 1], &b = cells_[i];
+    const bool visible = a.tau > 0 || b.tau > 0 || a.opaque > 0 || b.opaque > 0;
+    visibleBelow_[i] = visibleBelow_[i - 1] + (visible ? 1 : 0);
+  }
   // The nearest opaque node at or below each node, then at or above it.
   for (int i = 1; i < n; ++i)
-    if (nodes_[i].opaque == 0) opaqueColour_[2 * std::size_t(i)] = opaqueColour_[2 * std::size_t(i - 1)];
+    if (cells_[i].opaque == 0) opaqueColour_[2 * std::size_t(i)] = opaqueColour_[2 * std::size_t(i - 1)];
   for (int i = n - 2; i >= 0; --i)
-    if (nodes_[i].opaque == 0)
+    if (cells_[i].opaque == 0)
       opaqueColour_[2 * std::size_t(i) + 1] = opaqueColour_[2 * std::size_t(i + 1) + 1];
 }
 
 PreintegralTables PreintegratedTable::tables() const {
   PreintegralTables t;
-  t.nodes = nodes_.data();
+  t.cells = cells_.data();
   t.opaqueColour = opaqueColour_.data();
-  t.entries = int(nodes_.size());
+  t.visibleBelow = visibleBelow_.data();
+  t.entries = int(cells_.size());
   t.scale = scale_;
   t.offset = offset_;
   return t;

@@ -89,7 +89,8 @@ class PreintegratedTable {
 
  private:
   float scale_ = 0, offset_ = 0;
-  std::vector<PreintegralNode> nodes_;
+  std::vector<PreintegralCell> cells_;
+  std::vector<std::uint32_t> visibleBelow_;
   std::vector<Rgba> opaqueColour_;
 };
 

@@ -6,6 +6,7 @@
 
 #include "kernel.h"
 #include "kernel_batch.h"
+#include "preint_lighting.h"
 
 namespace pvr::core {
 
@@ -16,13 +17,14 @@ namespace kernel {
 template <typename T, bool kShaded, bool kPreintegrated>
 inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t start,
                       std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
+  if (start >= exit) return false;  // the batched kernel did them all: no window to set up
   const T* v = static_cast<const T*>(p.voxels);
   const float o0 = float(ray.origin[0]), o1 = float(ray.origin[1]), o2 = float(ray.origin[2]);
   const float d0 = float(ray.step[0]), d1 = float(ray.step[1]), d2 = float(ray.step[2]);
   // Pre-integrated: the samples at s - 1, s and s + 1 and segment s's front end.
   PreintWindow w;
   if constexpr (kPreintegrated) w = preintWindow<T>(p, ray, start);
-  float centre = 0.5f;  // pre-integrated: where in its segment to light it
+  float centre = 0.5f, spread = 0.0f;  // pre-integrated: where in its segment to light it
   for (std::int64_t s = start; s < exit; ++s) {
     const float x0 = o0 + float(s) * d0, x1 = o1 + float(s) * d1, x2 = o2 + float(s) * d2;
     Rgba c;
@@ -34,7 +36,7 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
       aroundRange(v, p, o0 + float(s + 1) * d0, o1 + float(s + 1) * d1, o2 + float(s + 1) * d2, lo, hi);
       const preint::End backEnd = segmentEnd<T>(p, curvedNode<T>(w.front, w.back, next, lo, hi));
       c = finite<T>(w.front) && finite<T>(w.back)
-              ? preint::segment(p.preint, w.frontEnd, backEnd, p.stepLength, &centre)
+              ? preint::segment(p.preint, w.frontEnd, backEnd, p.stepLength, &centre, &spread)
               : Rgba{};
       w.advance(next, backEnd);
     } else {
@@ -44,11 +46,9 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
     ++samples;
     if constexpr (kShaded) {
       if (!(c.a > 0)) continue;
-      // Pre-integrated: lit at the segment's middle, where the plain
-      // kernel's segment has its sample (second-order accurate).
+      // Pre-integrated: lit where the segment emits (preint_lighting.h).
       if constexpr (kPreintegrated) {
-        const float t = float(s) + centre;
-        c = shade(v, p, ray, o0 + t * d0, o1 + t * d1, o2 + t * d2, c);
+        c = shadeSegment(v, p, ray, float(s), 1.0f, centre, spread, c);
       } else {
         c = shade(v, p, ray, x0, x1, x2, c);
       }
@@ -62,7 +62,7 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
 // One sample standing for the segment [from, to] of the ray (in steps),
 // composited into acc: plain, classified and shaded at `at`, then
 // stretched from one step to the segment's length; pre-integrated from
-// `from` to `to` over the segment's own length and shaded at its middle.
+// `from` to `to` over the segment's own length and shaded where it emits.
 // `at` is a sample this brick owns (or a short chord's midpoint), and
 // `from` and `to` lie within a step of it, so every read stays within the
 // ghost layers (ghostLayers()). Returns true at early termination.
@@ -77,16 +77,16 @@ template <typename T, bool kShaded, bool kPreintegrated>
   };
   float x[3];
   Rgba c;
+  float centre = 0.5f, spread = 0.0f;  // pre-integrated: where to light it
   if constexpr (kPreintegrated) {
-    // Integrated over its own length: no stretching; lit at its middle.
+    // Integrated over its own length: no stretching.
     float f[3], b[3];
     position(from, f);
     position(to, b);
-    position(0.5 * (from + to), x);
     const float front = around(v, p, f[0], f[1], f[2]), back = around(v, p, b[0], b[1], b[2]);
     if (finite<T>(front) && finite<T>(back))
       c = preint::segment(p.preint, segmentEnd<T>(p, front), segmentEnd<T>(p, back),
-                          (to - from) * p.stepLength);
+                          (to - from) * p.stepLength, &centre, &spread);
   } else {
     position(at, x);
     const float value = trilinear(v, p, x[0], x[1], x[2], p.ownCellLo, p.ownCellHi);
@@ -94,7 +94,10 @@ template <typename T, bool kShaded, bool kPreintegrated>
   }
   ++samples;
   if constexpr (kShaded) {
-    if (c.a > 0) c = shade(v, p, ray, x[0], x[1], x[2], c);
+    if (c.a > 0) {
+      if constexpr (kPreintegrated) c = shadeSegment(v, p, ray, float(from), float(to - from), centre, spread, c);
+      else c = shade(v, p, ray, x[0], x[1], x[2], c);
+    }
   }
   if constexpr (!kPreintegrated) c = stretch(c, to - from);
   acc.addBehind(c);

@@ -19,6 +19,8 @@
 #include <type_traits>
 
 #include "kernel.h"
+#include "preint_lanes.h"
+#include "preint_lighting.h"
 
 namespace pvr::core::kernel {
 
@@ -175,68 +177,157 @@ template <typename T>
 }
 
 // Pre-integrated segments [s, s + 1) for s in [start, exit), eight at a
-// time while eight remain: the scalars at s + 2 .. s + 9 in one batch, the
-// eight corrected nodes s + 1 .. s + 8 (curvedNode()) in another, the
-// segments (preintegration.h) and the "over" per segment in order; the
-// caller takes the rest one at a time. `start` advances past what was done.
-// Returns true at the early-termination opacity.
+// time: the scalars at s + 2 .. s + 9 in one batch, the eight corrected
+// nodes s + 1 .. s + 8 (curvedNode()) in another, the eight segments
+// (preint_lanes.h) and the "over" per segment in order. With AVX-512 the
+// last batch may be partial (its lanes beyond `exit` read clamped positions
+// and are not composited) and `start` ends at `exit`; without, the
+// segments are integrated per lane, eight at a time while eight remain, and
+// the caller takes the rest one at a time. `start` advances past what was
+// done. Returns true at the early-termination opacity.
 template <typename T, bool kShaded>
 inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
                                     std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
-  if (start + 8 > exit) return false;
+#ifdef PVR_HAVE_PREINT_LANES
+  constexpr std::int64_t kFullBatchesOnly = 0;
+#else
+  constexpr std::int64_t kFullBatchesOnly = 7;
+#endif
+  if (start + kFullBatchesOnly >= exit) return false;
   const T* v = static_cast<const T*>(p.voxels);
   const __m256 o[3] = {_mm256_set1_ps(float(ray.origin[0])), _mm256_set1_ps(float(ray.origin[1])),
                        _mm256_set1_ps(float(ray.origin[2]))};
   const __m256 d[3] = {_mm256_set1_ps(float(ray.step[0])), _mm256_set1_ps(float(ray.step[1])),
                        _mm256_set1_ps(float(ray.step[2]))};
-  const PreintWindow w = preintWindow<T>(p, ray, start);
-  preint::End frontEnd = w.frontEnd;
+  const __m256 finiteMax = _mm256_set1_ps(FLT_MAX), signBit = _mm256_set1_ps(-0.0f);
+  auto finite8 = [&](__m256 x) __attribute__((always_inline)) {
+    return _mm256_cmp_ps(_mm256_andnot_ps(signBit, x), finiteMax, _CMP_LE_OQ);
+  };
   // raw[j]: the sample at s + j, j in [0, 10); lo[j], hi[j] its cell's range.
   alignas(32) float raw[16], lo[16], hi[16];
-  raw[0] = w.front;
-  raw[1] = w.back;
+  // The window at `start` (preintWindow()): the samples at start - 1 ..
+  // start + 6 in one batch; the front node at `start`, and the sample at
+  // start + 1 and its range for the first batch's first node.
+  preint::End frontEnd;
+  float frontScalar;
   {
-    const float t = float(start + 1);
-    aroundRange(v, p, float(ray.origin[0]) + t * float(ray.step[0]), float(ray.origin[1]) + t * float(ray.step[1]),
-                float(ray.origin[2]) + t * float(ray.step[2]), lo[1], hi[1]);
-  }
-  for (std::int64_t s = start; s + 8 <= exit; s += 8, start = s) {
+    alignas(32) float first[8], firstLo[8], firstHi[8];
     __m256 lo8, hi8;
-    _mm256_storeu_ps(raw + 2, aroundBatch(v, p, o, d, s + 2, lo8, hi8));
-    _mm256_storeu_ps(lo + 2, lo8);
-    _mm256_storeu_ps(hi + 2, hi8);
-    const __m256 before = _mm256_loadu_ps(raw), at = _mm256_loadu_ps(raw + 1), after = _mm256_loadu_ps(raw + 2);
-    const __m256 bend = _mm256_add_ps(_mm256_sub_ps(before, _mm256_add_ps(at, at)), after);
-    __m256 node = _mm256_sub_ps(at, _mm256_mul_ps(bend, _mm256_set1_ps(1.0f / 12.0f)));
-    const __m256 clamped = _mm256_min_ps(_mm256_max_ps(node, _mm256_loadu_ps(lo + 1)), _mm256_loadu_ps(hi + 1));
-    if constexpr (std::is_floating_point_v<T>) {
-      const __m256 magnitude = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), node);
-      node = _mm256_blendv_ps(at, clamped, _mm256_cmp_ps(magnitude, _mm256_set1_ps(FLT_MAX), _CMP_LE_OQ));
-    } else {
-      node = clamped;
-    }
-    alignas(32) float back[8];
-    _mm256_store_ps(back, node);
-    for (int lane = 0; lane < 8; ++lane) {
-      const preint::End backEnd = segmentEnd<T>(p, back[lane]);
-      float centre = 0.5f;
-      Rgba c = finite<T>(raw[lane]) && finite<T>(raw[lane + 1])
-                   ? preint::segment(p.preint, frontEnd, backEnd, p.stepLength, &centre)
-                   : Rgba{};
-      frontEnd = backEnd;
-      if constexpr (kShaded) {
-        if (!(c.a > 0)) continue;
-        const float t = float(s + lane) + centre;
-        c = shade(v, p, ray, float(ray.origin[0]) + t * float(ray.step[0]),
-                  float(ray.origin[1]) + t * float(ray.step[1]), float(ray.origin[2]) + t * float(ray.step[2]), c);
-      }
-      acc.addBehind(c);
-    }
+    _mm256_store_ps(first, aroundBatch(v, p, o, d, start - 1, lo8, hi8));
+    _mm256_store_ps(firstLo, lo8);
+    _mm256_store_ps(firstHi, hi8);
+    frontScalar = curvedNode<T>(first[0], first[1], first[2], firstLo[1], firstHi[1]);
+    if (!finite<T>(frontScalar)) frontScalar = 0;  // looked up as 0 (segmentEnd())
+    frontEnd = preint::endAt(p.preint, frontScalar);
+    raw[0] = first[1];
+    raw[1] = first[2];
+    lo[1] = firstLo[2];
+    hi[1] = firstHi[2];
+  }
+  // On to the next batch, `count` segments done: the two samples before
+  // its first node carried over.
+  auto advance = [&](std::int64_t s, int count) __attribute__((always_inline)) {
     raw[0] = raw[8];
     raw[1] = raw[9];
     lo[1] = lo[9];
     hi[1] = hi[9];
-    samples += 8;
+    samples += std::uint64_t(count);
+    start = s + count;
+  };
+#ifdef PVR_HAVE_PREINT_LANES
+  // Lane 7 of `before`: the next segment's front end, at node frontNode
+  // (stale after a batch of empty cells).
+  preint::Ends8 before = preint::broadcast(frontEnd);
+  float frontNode = frontScalar;
+  bool frontStale = false;
+#endif
+  for (std::int64_t s = start; s + kFullBatchesOnly < exit; s += 8) {
+    __m256 lo8, hi8;
+    _mm256_storeu_ps(raw + 2, aroundBatch(v, p, o, d, s + 2, lo8, hi8));
+    _mm256_storeu_ps(lo + 2, lo8);
+    _mm256_storeu_ps(hi + 2, hi8);
+    const __m256 before8 = _mm256_loadu_ps(raw), at = _mm256_loadu_ps(raw + 1), after = _mm256_loadu_ps(raw + 2);
+    const __m256 bend = _mm256_add_ps(_mm256_sub_ps(before8, _mm256_add_ps(at, at)), after);
+    __m256 node = _mm256_sub_ps(at, _mm256_mul_ps(bend, _mm256_set1_ps(1.0f / 12.0f)));
+    const __m256 clamped = _mm256_min_ps(_mm256_max_ps(node, _mm256_loadu_ps(lo + 1)), _mm256_loadu_ps(hi + 1));
+    if constexpr (std::is_floating_point_v<T>) {
+      node = _mm256_blendv_ps(at, clamped, finite8(node));
+    } else {
+      node = clamped;
+    }
+    const int count = int(std::min<std::int64_t>(8, exit - s));  // segments of this batch
+#ifdef PVR_HAVE_PREINT_LANES
+    // A segment with a non-finite sample at an end is empty; its node is
+    // looked up as 0 (segmentEnd()).
+    unsigned valid = (1u << count) - 1;
+    if constexpr (std::is_floating_point_v<T>) {
+      node = _mm256_and_ps(node, finite8(node));
+      valid &= unsigned(_mm256_movemask_ps(_mm256_and_ps(finite8(before8), finite8(at))));
+    }
+    // A batch whose nodes all lie in empty cells integrates nothing: skip
+    // the table, count the samples; the front end is looked up again only
+    // when a batch needs it.
+    const float nextFront = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(node, _mm256_set1_epi32(7)));
+    if (preint::allEmpty(p.preint, node, frontNode)) {
+      frontStale = true;
+      frontNode = nextFront;
+      advance(s, count);
+      continue;
+    }
+    if (frontStale) before = preint::broadcast(preint::endAt(p.preint, frontNode));
+    frontStale = false;
+    frontNode = nextFront;
+    const preint::Ends8 backs = preint::endsAt(p.preint, node);
+    const preint::Ends8 fronts = preint::fronts(before, backs);
+    const preint::Segments8 seg = preint::segments<kShaded>(fronts, backs, p.stepLength);
+    alignas(32) float r[8], g[8], b[8], a[8], centre[8], spread[8];
+    _mm256_store_ps(r, _mm512_maskz_cvtpd_ps(preint::kAll, seg.r));
+    _mm256_store_ps(g, _mm512_maskz_cvtpd_ps(preint::kAll, seg.g));
+    _mm256_store_ps(b, _mm512_maskz_cvtpd_ps(preint::kAll, seg.b));
+    _mm256_store_ps(a, _mm512_maskz_cvtpd_ps(preint::kAll, seg.a));
+    if constexpr (kShaded) {
+      _mm256_store_ps(centre, _mm512_maskz_cvtpd_ps(preint::kAll, seg.centre));
+      _mm256_store_ps(spread, _mm512_maskz_cvtpd_ps(preint::kAll, seg.spread));
+    }
+    alignas(64) double frontX[8], backX[8];
+    if (seg.opaque) {
+      _mm512_store_pd(backX, backs.x);
+      _mm512_store_pd(frontX, fronts.x);
+    }
+    before = backs;
+    // Composite the segments that add anything, in order.
+    unsigned lanes = valid & (unsigned(_mm512_cmp_pd_mask(seg.a, _mm512_setzero_pd(), _CMP_GT_OQ)) | seg.opaque);
+    for (; lanes; lanes &= lanes - 1) {
+      const int lane = __builtin_ctz(lanes);
+      Rgba c{r[lane], g[lane], b[lane], a[lane]};
+      float middle = 0.5f, around = 0.0f;  // opaque segments are lit at their middle (segment())
+      if (seg.opaque & (1u << lane)) {
+        c = preint::opaqueSegment(p.preint, frontX[lane], backX[lane]);
+      } else if constexpr (kShaded) {
+        middle = centre[lane];
+        around = spread[lane];
+      }
+      if constexpr (kShaded) c = shadeSegment(v, p, ray, float(s + lane), 1.0f, middle, around, c);
+      acc.addBehind(c);
+    }
+#else
+    alignas(32) float back[8];
+    _mm256_store_ps(back, node);
+    for (int lane = 0; lane < 8; ++lane) {
+      const preint::End backEnd = segmentEnd<T>(p, back[lane]);
+      float centre = 0.5f, spread = 0.0f;
+      Rgba c = finite<T>(raw[lane]) && finite<T>(raw[lane + 1])
+                   ? preint::segment(p.preint, frontEnd, backEnd, p.stepLength, &centre, &spread)
+                   : Rgba{};
+      frontEnd = backEnd;
+      if constexpr (kShaded) {
+        if (!(c.a > 0)) continue;
+        c = shadeSegment(v, p, ray, float(s + lane), 1.0f, centre, spread, c);
+      }
+      acc.addBehind(c);
+    }
+#endif
+    advance(s, count);
     if (acc.a >= p.earlyTermination) return true;
   }
   return false;

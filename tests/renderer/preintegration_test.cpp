@@ -12,6 +12,7 @@
 #include "raycast/cast_ray.h"
 #include "raycast/kernel_setup.h"
 #include "raycast/macrocells.h"
+#include "preintegrated_kernel.h"
 #include "reference.h"
 #include "transfer.h"
 
@@ -264,32 +265,22 @@ TEST_CASE("the batched pre-integrated kernel equals the scalar kernel", "[preint
     const TransferFunctionSpec& f = volume.type() == ScalarType::kUInt8 ? tf8 : tf;
     for (bool shaded : {false, true}) {
       const RenderOptions o = makeOptions(0.45, true, shaded);
-      MacrocellGrid macrocells(volume);
-      const TransferTable table(f, o.step);
-      const PreintegratedTable pre(f);
-      macrocells.classify(table, false);
-      KernelParams p;
-      setBrick(p, volume, macrocells);
-      setTables(p, table, &pre, o.step);
-      const std::vector<float> specular = specularTable(o.shading.shininess);
-      setOptions(p, o, specular.data());
+      const PreintegratedKernel setup(volume, f, o);
+      const KernelParams& p = setup.params();
       REQUIRE(p.indices32);
       double worst = 0;
       int rays = 0;
-      for (int y = 0; y < 24; ++y)
-        for (int x = 0; x < 24; ++x) {
-          const RaySetup ray = raySetup(camera.ray(x, y), grid, o.step, normalize(Vec3{0.2, 0.4, -1}));
-          std::int64_t first, last;
-          if (!kernel::sampleRange(p, ray, first, last) || last - first < 20) continue;
-          const bool uint8 = volume.type() == ScalarType::kUInt8;
-          const double difference =
-              uint8 ? (shaded ? batchedAgainstScalar<std::uint8_t, true>(p, ray, first, last)
-                              : batchedAgainstScalar<std::uint8_t, false>(p, ray, first, last))
-                    : (shaded ? batchedAgainstScalar<float, true>(p, ray, first, last)
-                              : batchedAgainstScalar<float, false>(p, ray, first, last));
-          worst = std::max(worst, difference);
-          ++rays;
-        }
+      setup.forEachRay(camera, grid, o.step, [&](const RaySetup& ray, std::int64_t first, std::int64_t last) {
+        if (last - first < 20) return;
+        const bool uint8 = volume.type() == ScalarType::kUInt8;
+        const double difference =
+            uint8 ? (shaded ? batchedAgainstScalar<std::uint8_t, true>(p, ray, first, last)
+                            : batchedAgainstScalar<std::uint8_t, false>(p, ray, first, last))
+                  : (shaded ? batchedAgainstScalar<float, true>(p, ray, first, last)
+                            : batchedAgainstScalar<float, false>(p, ray, first, last));
+        worst = std::max(worst, difference);
+        ++rays;
+      });
       INFO((volume.type() == ScalarType::kUInt8 ? "uint8" : "float32")
            << (shaded ? " shaded" : " unshaded") << ": " << rays << " rays, max difference " << worst);
       CHECK(rays > 100);

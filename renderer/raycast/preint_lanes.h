@@ -1,0 +1,258 @@
+// Eight pre-integrated segments at once: preintegration.h's endAt() and
+// segment() across the eight lanes of a batch, in AVX-512 double.
+//
+// Double, because a segment's integral is a difference of two cumulative
+// sums (preintegration.h); eight doubles fill one 512-bit vector, so this
+// costs the instructions that eight floats in AVX2 would. The table is read
+// as rows, not gathered: each lane's cell is two 64-byte loads, and two
+// 8x8 transposes turn the eight cells into one vector per field (this
+// machine's hardware gathers cost ~19 cycles each; a transpose is 24
+// shuffles for 64 values). Opaque segments, rare, stay per lane
+// (preint::opaqueSegment).
+#pragma once
+
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+#define PVR_HAVE_PREINT_LANES 1
+
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cstdint>
+
+#include "../preintegration.h"
+
+namespace pvr::core::preint {
+
+// Every lane. The masked forms of the intrinsics, with this mask, compile to
+// the unmasked instructions; the unmasked forms start from GCC 12's
+// "undefined" vectors, which -Wmaybe-uninitialized reports at every use.
+inline constexpr __mmask8 kAll = 0xff;
+
+// The integrals at eight segment ends (End, one field per vector).
+struct Ends8 {
+  __m512d x, tau, T, M, K[3], O, k[3], opaque;
+};
+
+// Row j of r becomes column j: r[f][j] = old r[j][f].
+[[gnu::always_inline]] inline void transpose8x8(__m512d r[8]) {
+  __m512d t[8], u[8];
+  for (int j = 0; j < 8; j += 2) {
+    t[j] = _mm512_maskz_unpacklo_pd(kAll, r[j], r[j + 1]);      // r[j][0] r[j+1][0] r[j][2] r[j+1][2] ...
+    t[j + 1] = _mm512_maskz_unpackhi_pd(kAll, r[j], r[j + 1]);  // r[j][1] r[j+1][1] r[j][3] r[j+1][3] ...
+  }
+  // 128-bit pairs of rows j, j+1 beside those of rows j+2, j+3.
+  const __m512i even = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13);
+  const __m512i odd = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
+  for (int h = 0; h < 8; h += 4) {
+    u[h + 0] = _mm512_permutex2var_pd(t[h + 0], even, t[h + 2]);  // fields 0 and 4 of rows h..h+3
+    u[h + 1] = _mm512_permutex2var_pd(t[h + 1], even, t[h + 3]);  // fields 1 and 5
+    u[h + 2] = _mm512_permutex2var_pd(t[h + 0], odd, t[h + 2]);   // fields 2 and 6
+    u[h + 3] = _mm512_permutex2var_pd(t[h + 1], odd, t[h + 3]);   // fields 3 and 7
+  }
+  // Rows 0..3 beside rows 4..7.
+  for (int f = 0; f < 4; ++f) {
+    r[f] = _mm512_maskz_shuffle_f64x2(kAll, u[f], u[4 + f], 0x44);
+    r[f + 4] = _mm512_maskz_shuffle_f64x2(kAll, u[f], u[4 + f], 0xEE);
+  }
+}
+
+// endAt() of eight finite scalars.
+[[gnu::always_inline]] inline Ends8 endsAt(const PreintegralTables& t, __m256 scalar) {
+  Ends8 e;
+  e.x = _mm512_add_pd(_mm512_mul_pd(_mm512_maskz_cvtps_pd(kAll, scalar), _mm512_set1_pd(double(t.scale))),
+                      _mm512_set1_pd(double(t.offset)));
+  const __m512d xc = _mm512_maskz_min_pd(kAll, _mm512_maskz_max_pd(kAll, e.x, _mm512_setzero_pd()), _mm512_set1_pd(double(t.entries - 1)));
+  const __m256i i = _mm256_min_epi32(_mm512_maskz_cvttpd_epi32(kAll, xc), _mm256_set1_epi32(t.entries - 2));
+  const __m512d di = _mm512_maskz_cvtepi32_pd(kAll, i);
+  const __m512d w = _mm512_sub_pd(xc, di), beyond = _mm512_sub_pd(e.x, xc);
+  alignas(32) std::int32_t cell[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(cell), i);
+  __m512d row0[8], row1[8];
+  for (int j = 0; j < 8; ++j) {
+    const double* c = &t.cells[cell[j]].tau;
+    row0[j] = _mm512_load_pd(c);
+    row1[j] = _mm512_load_pd(c + 8);
+  }
+  transpose8x8(row0);  // tau dtau T M K0 K1 K2 O
+  transpose8x8(row1);  // k0 k1 k2 dk0 dk1 dk2 opaque dopaque
+  const __m512d half = _mm512_set1_pd(0.5);
+  // point: f_a + w df; partial: w (f_a + w/2 df), as endAt().
+  auto point = [&](__m512d fa, __m512d df) __attribute__((always_inline)) { return _mm512_fmadd_pd(w, df, fa); };
+  auto partial = [&](__m512d fa, __m512d df) __attribute__((always_inline)) {
+    return _mm512_mul_pd(w, _mm512_fmadd_pd(_mm512_mul_pd(half, w), df, fa));
+  };
+  e.tau = point(row0[0], row0[1]);
+  const __m512d partialT = partial(row0[0], row0[1]);
+  e.T = _mm512_fmadd_pd(beyond, e.tau, _mm512_add_pd(row0[2], partialT));
+  // M: i * partial + w^2 (tau_a / 2 + w dtau / 3) + tau beyond (x + xc) / 2.
+  const __m512d curve = _mm512_fmadd_pd(_mm512_mul_pd(w, row0[1]), _mm512_set1_pd(1.0 / 3),
+                                        _mm512_mul_pd(half, row0[0]));
+  const __m512d outside = _mm512_mul_pd(_mm512_mul_pd(half, e.tau), _mm512_mul_pd(beyond, _mm512_add_pd(e.x, xc)));
+  e.M = _mm512_add_pd(_mm512_add_pd(row0[3], _mm512_mul_pd(di, partialT)),
+                      _mm512_fmadd_pd(_mm512_mul_pd(w, w), curve, outside));
+  for (int c = 0; c < 3; ++c) {
+    e.k[c] = point(row1[c], row1[3 + c]);
+    e.K[c] = _mm512_fmadd_pd(beyond, e.k[c], _mm512_add_pd(row0[4 + c], partial(row1[c], row1[3 + c])));
+  }
+  e.opaque = point(row1[6], row1[7]);
+  e.O = _mm512_fmadd_pd(beyond, e.opaque, _mm512_add_pd(row0[7], partial(row1[6], row1[7])));
+  return e;
+}
+
+// True when the eight scalars and `front` all lie in empty cells
+// (visibleBelow), with a cell of margin for the float rounding of their
+// table coordinates: no segment between them integrates anything.
+[[gnu::always_inline]] inline bool allEmpty(const PreintegralTables& t, __m256 scalar, float front) {
+  const __m256 scale = _mm256_set1_ps(t.scale), offset = _mm256_set1_ps(t.offset), f = _mm256_set1_ps(front);
+  // Least and greatest table coordinate (scale >= 0), in every lane.
+  __m256 lo = _mm256_fmadd_ps(_mm256_min_ps(scalar, f), scale, offset);
+  __m256 hi = _mm256_fmadd_ps(_mm256_max_ps(scalar, f), scale, offset);
+  lo = _mm256_min_ps(lo, _mm256_permute2f128_ps(lo, lo, 1));
+  hi = _mm256_max_ps(hi, _mm256_permute2f128_ps(hi, hi, 1));
+  lo = _mm256_min_ps(lo, _mm256_shuffle_ps(lo, lo, 0x4e));
+  hi = _mm256_max_ps(hi, _mm256_shuffle_ps(hi, hi, 0x4e));
+  lo = _mm256_min_ps(lo, _mm256_shuffle_ps(lo, lo, 0xb1));
+  hi = _mm256_max_ps(hi, _mm256_shuffle_ps(hi, hi, 0xb1));
+  const float last = float(t.entries - 1);
+  auto cell = [&](float x) __attribute__((always_inline)) {
+    return std::min(int(std::clamp(x, 0.0f, last)), t.entries - 2);
+  };
+  const int first = std::max(cell(_mm256_cvtss_f32(lo)) - 1, 0);
+  const int final = std::min(cell(_mm256_cvtss_f32(hi)) + 1, t.entries - 2);
+  return t.visibleBelow[final + 1] == t.visibleBelow[first];
+}
+
+// The eight ends before these: lane 0 from lane 7 of `before`, lane j from
+// lane j - 1 of `e` (the back end of one segment is the front of the next).
+[[gnu::always_inline]] inline Ends8 fronts(const Ends8& before, const Ends8& e) {
+  auto shift = [](__m512d b, __m512d a) __attribute__((always_inline)) {
+    return _mm512_castsi512_pd(_mm512_maskz_alignr_epi64(kAll, _mm512_castpd_si512(a), _mm512_castpd_si512(b), 7));
+  };
+  Ends8 f;
+  f.x = shift(before.x, e.x);
+  f.tau = shift(before.tau, e.tau);
+  f.T = shift(before.T, e.T);
+  f.M = shift(before.M, e.M);
+  f.O = shift(before.O, e.O);
+  f.opaque = shift(before.opaque, e.opaque);
+  for (int c = 0; c < 3; ++c) {
+    f.K[c] = shift(before.K[c], e.K[c]);
+    f.k[c] = shift(before.k[c], e.k[c]);
+  }
+  return f;
+}
+
+// Eight lanes all holding one End (lane 7 is what fronts() reads).
+inline Ends8 broadcast(const End& end) {
+  Ends8 e;
+  e.x = _mm512_set1_pd(end.x);
+  e.tau = _mm512_set1_pd(end.tau);
+  e.T = _mm512_set1_pd(end.T);
+  e.M = _mm512_set1_pd(end.M);
+  e.O = _mm512_set1_pd(end.O);
+  e.opaque = _mm512_set1_pd(end.opaque);
+  for (int c = 0; c < 3; ++c) {
+    e.K[c] = _mm512_set1_pd(end.K[c]);
+    e.k[c] = _mm512_set1_pd(end.k[c]);
+  }
+  return e;
+}
+
+// 1 / x to double precision: the 14-bit estimate and two Newton steps, each
+// doubling its bits (a division's divider takes 16 cycles a vector).
+[[gnu::always_inline]] inline __m512d reciprocal(__m512d x) {
+  const __m512d one = _mm512_set1_pd(1.0);
+  __m512d r = _mm512_maskz_rcp14_pd(kAll, x);
+  r = _mm512_fmadd_pd(r, _mm512_fnmadd_pd(x, r, one), r);
+  return _mm512_fmadd_pd(r, _mm512_fnmadd_pd(x, r, one), r);
+}
+
+// expm1(x) for x <= 0 to a few ulps: x = n ln2 + r, |r| <= ln2 / 2, a
+// degree-12 Taylor polynomial for expm1(r) (its remainder is below 2e-16
+// relative), then 2^n (expm1(r) + 1) - 1, which cannot cancel for n != 0.
+[[gnu::always_inline]] inline __m512d expm1NonPositive(__m512d x) {
+  x = _mm512_maskz_max_pd(kAll, x, _mm512_set1_pd(-700.0));
+  const __m512d n = _mm512_maskz_roundscale_pd(kAll, _mm512_mul_pd(x, _mm512_set1_pd(1.4426950408889634)),
+                                         _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+  __m512d r = _mm512_fnmadd_pd(n, _mm512_set1_pd(6.93147180369123816490e-01), x);
+  r = _mm512_fnmadd_pd(n, _mm512_set1_pd(1.90821492927058770002e-10), r);
+  constexpr double kInverseFactorial[] = {1.0 / 479001600, 1.0 / 39916800, 1.0 / 3628800, 1.0 / 362880,
+                                          1.0 / 40320,     1.0 / 5040,     1.0 / 720,     1.0 / 120,
+                                          1.0 / 24,        1.0 / 6,        0.5,           1.0};
+  __m512d p = _mm512_set1_pd(kInverseFactorial[0]);
+  for (int j = 1; j < 12; ++j) p = _mm512_fmadd_pd(p, r, _mm512_set1_pd(kInverseFactorial[j]));
+  p = _mm512_mul_pd(p, r);  // expm1(r)
+  const __m512d scaled = _mm512_sub_pd(_mm512_maskz_scalef_pd(kAll, _mm512_add_pd(p, _mm512_set1_pd(1.0)), n),
+                                       _mm512_set1_pd(1.0));
+  return _mm512_mask_blend_pd(_mm512_cmp_pd_mask(n, _mm512_setzero_pd(), _CMP_EQ_OQ), scaled, p);
+}
+
+// Eight segments from `f` to `b`, each `length` world units: segment()'s
+// premultiplied colour and opacity and, with kCentre, where to light it
+// (centre and spread).
+// Lanes that segment() would make opaque are flagged in `opaque` and left
+// empty here (their colour: opaqueSegment()); so are lanes with no
+// extinction.
+struct Segments8 {
+  __m512d r, g, b, a;
+  __m512d centre, spread;
+  __mmask8 opaque;
+};
+
+template <bool kCentre>
+[[gnu::always_inline]] inline Segments8 segments(const Ends8& f, const Ends8& b, double length) {
+  Segments8 s;
+  const __m512d zero = _mm512_setzero_pd(), half = _mm512_set1_pd(0.5);
+  const __m512d dx = _mm512_sub_pd(b.x, f.x);
+  const __mmask8 wide = _mm512_cmp_pd_mask(_mm512_abs_pd(dx), _mm512_set1_pd(kMinSpan), _CMP_GT_OQ);
+  s.opaque = (wide & _mm512_cmp_pd_mask(b.O, f.O, _CMP_NEQ_UQ)) | _mm512_cmp_pd_mask(f.opaque, zero, _CMP_GT_OQ) |
+             _mm512_cmp_pd_mask(b.opaque, zero, _CMP_GT_OQ);
+  // Mean extinction and colour: difference quotients where the ends are
+  // apart, the ends' mean where they are not.
+  const __m512d inv = reciprocal(dx);  // used where wide only
+  const __m512d dT = _mm512_sub_pd(b.T, f.T);
+  const __m512d tau = _mm512_mask_blend_pd(wide, _mm512_mul_pd(half, _mm512_add_pd(f.tau, b.tau)),
+                                           _mm512_mul_pd(dT, inv));
+  __m512d k[3];
+  for (int c = 0; c < 3; ++c)
+    k[c] = _mm512_mask_blend_pd(wide, _mm512_mul_pd(half, _mm512_add_pd(f.k[c], b.k[c])),
+                                _mm512_mul_pd(_mm512_sub_pd(b.K[c], f.K[c]), inv));
+  const __mmask8 visible = _mm512_cmp_pd_mask(tau, zero, _CMP_GT_OQ) & ~s.opaque;
+  const __m512d depth = _mm512_mul_pd(tau, _mm512_set1_pd(length));
+  const __m512d alpha = _mm512_maskz_sub_pd(visible, zero, expm1NonPositive(_mm512_sub_pd(zero, depth)));
+  // Mean colour k / tau, times alpha.
+  const __m512d weight = _mm512_maskz_mul_pd(visible, alpha, reciprocal(tau));
+  s.r = _mm512_mul_pd(k[0], weight);
+  s.g = _mm512_mul_pd(k[1], weight);
+  s.b = _mm512_mul_pd(k[2], weight);
+  s.a = alpha;
+  if constexpr (kCentre) {
+    // The extinction's centroid, then moved frontwards by self-attenuation
+    // (segment()): 1/D - 1/(e^D - 1) - 1/2, with 1/(e^D - 1) = (1 - alpha) / alpha.
+    const __m512d sum = _mm512_add_pd(f.tau, b.tau);
+    const __m512d num = _mm512_mask_blend_pd(wide, _mm512_fmadd_pd(_mm512_set1_pd(2.0), b.tau, f.tau),
+                                             _mm512_sub_pd(b.M, f.M));
+    const __m512d den = _mm512_mask_blend_pd(wide, _mm512_mul_pd(_mm512_set1_pd(3.0), sum), dT);
+    const __m512d quotient = _mm512_mul_pd(num, reciprocal(den));
+    __m512d at = _mm512_mask_blend_pd(wide, quotient, _mm512_mul_pd(_mm512_sub_pd(quotient, f.x), inv));
+    at = _mm512_mask_blend_pd(wide | _mm512_cmp_pd_mask(sum, zero, _CMP_GT_OQ), half, at);
+    const __m512d one = _mm512_set1_pd(1.0);
+    const __m512d inverseDepth = reciprocal(depth), inverseAlpha = reciprocal(alpha);
+    const __m512d transmitted = _mm512_mul_pd(_mm512_sub_pd(one, alpha), inverseAlpha);  // 1 / (e^D - 1)
+    const __m512d thick = _mm512_sub_pd(_mm512_sub_pd(inverseDepth, transmitted), half);
+    const __mmask8 thin = _mm512_cmp_pd_mask(depth, _mm512_set1_pd(1e-3), _CMP_LT_OQ);
+    at = _mm512_add_pd(at, _mm512_mask_blend_pd(thin, thick, _mm512_mul_pd(depth, _mm512_set1_pd(-1.0 / 12))));
+    s.centre = _mm512_maskz_min_pd(kAll, _mm512_maskz_max_pd(kAll, at, zero), one);
+    // emissionVariance(), and its square root.
+    const __m512d variance = _mm512_mask_blend_pd(
+        _mm512_cmp_pd_mask(depth, _mm512_set1_pd(1e-2), _CMP_LT_OQ),
+        _mm512_fmsub_pd(inverseDepth, inverseDepth, _mm512_mul_pd(transmitted, inverseAlpha)),
+        _mm512_fnmadd_pd(_mm512_mul_pd(depth, depth), _mm512_set1_pd(1.0 / 720), _mm512_set1_pd(1.0 / 12)));
+    s.spread = _mm512_maskz_sqrt_pd(kAll, _mm512_maskz_max_pd(kAll, variance, zero));
+  }
+  return s;
+}
+
+}  // namespace pvr::core::preint
+
+#endif
