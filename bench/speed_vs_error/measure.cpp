@@ -10,7 +10,6 @@
 #include <limits>
 #include <string_view>
 
-#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include "camera.h"
@@ -208,25 +207,6 @@ double loadAverage1() {
   double load = 0;
   in >> load;
   return load;
-}
-
-core::Image readRgb8(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw Error(ErrorCode::kIo, path + ": cannot read (" + OIIO::geterror() + ")");
-  const OIIO::ImageSpec& spec = in->spec();
-  const int w = spec.width, h = spec.height, channels = spec.nchannels;
-  if (channels < 3) throw Error(ErrorCode::kIo, path + ": not an RGB image");
-  std::vector<unsigned char> bytes(std::size_t(w) * std::size_t(h) * std::size_t(channels));
-  const bool read = in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, bytes.data());
-  in->close();
-  if (!read) throw Error(ErrorCode::kIo, path + ": cannot read its pixels");
-  core::Image out = core::Image::fullFrame(w, h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const unsigned char* p = &bytes[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * std::size_t(channels)];
-      out.at(x, y) = {p[0] / 255.0f, p[1] / 255.0f, p[2] / 255.0f, 0.0f};
-    }
-  return out;
 }
 
 core::Image quantised8(const core::Image& image) {

@@ -123,9 +123,7 @@ double loadAverage1();
 // image over black is its RGB, so the reference's RGB is what a perfect
 // renderer would have drawn; alpha is not compared.
 //
-// An 8-bit RGB file (PNG) as an image of RGB / 255 (alpha 0). Throws
-// pvr::Error naming the path.
-core::Image readRgb8(const std::string& path);
+// (The other renderer's file is read by core::readPngCodes.)
 // The image over black, each channel rounded to 8 bits as a PNG would hold it.
 core::Image quantised8(const core::Image& image);
 // RMSE, PSNR and max abs error over the R, G and B channels only, full frame.
