@@ -109,4 +109,26 @@ Image readExr(const std::string& path) {
   return image;
 }
 
+Image readPngCodes(const std::string& path) {
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);  // the colour as stored, never multiplied by alpha
+  auto in = OIIO::ImageInput::open(path, &config);
+  if (!in) ioError(path, "cannot read", OIIO::geterror());
+  if (std::string(in->format_name()) != "png")
+    throw Error(ErrorCode::kBadFile, path + ": not a PNG file (it is " + in->format_name() + ")");
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.nchannels < 3)
+    throw Error(ErrorCode::kBadFile, path + ": " + std::to_string(spec.nchannels) + " channel(s), need R, G and B");
+  std::vector<std::uint8_t> bytes(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, bytes.data()))
+    ioError(path, "read failed", in->geterror());
+  Image image = Image::fullFrame(spec.width, spec.height);
+  for (int y = 0; y < spec.height; ++y)
+    for (int x = 0; x < spec.width; ++x) {
+      const std::uint8_t* p = &bytes[(std::size_t(y) * std::size_t(spec.width) + std::size_t(x)) * std::size_t(spec.nchannels)];
+      image.at(x, y) = {p[0] / 255.0f, p[1] / 255.0f, p[2] / 255.0f, 0.0f};
+    }
+  return image;
+}
+
 }  // namespace pvr::core

@@ -31,4 +31,10 @@ void writeImage(const Image& image, const std::array<double, 4>& background, con
 // image's rect its data window (clipped to the frame).
 Image readExr(const std::string& path);
 
+// Reads an 8-bit PNG's R, G and B code values as stored, each / 255: no
+// sRGB decoding, alpha not applied, alpha 0 in the image. For comparing
+// another program's frame number for number (bench/speed_vs_error
+// --peer-png: VTK writes the values it composited).
+Image readPngCodes(const std::string& path);
+
 }  // namespace pvr::core

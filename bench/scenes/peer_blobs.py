@@ -5,6 +5,8 @@
                                 with the peer's make_volume.py (needs numpy),
                                 then PVR's sidecar OUTDIR/peer_blobs_256.json
   peer_blobs.py scene           prints the scene document (bench/scenes/peer_blobs.json)
+  peer_blobs.py vtk-model OUT   writes the same scene as VTK composites it, for
+                                VTK's error against its own model (see vtk_model)
 
 The scene is derived from peer_common.py, so it is the peer's transfer
 function and camera, not a copy typed by hand:
@@ -101,6 +103,37 @@ def scene():
     return text + "\n"
 
 
+def srgb_encode(v):
+    """Linear value to its sRGB encoding: the inverse of PVR's srgbToLinear
+    (renderer/image_srgb.h), so PVR decodes it back to v."""
+    return 12.92 * v if v <= 0.0031308 else 1.055 * v ** (1 / 2.4) - 0.055
+
+
+def vtk_model(out):
+    """The peer scene as VTK renders it, in PVR's terms, written to OUT.
+
+    PVR reads transfer-function colours as display sRGB and composites their
+    linear decoding; VTK composites the numbers themselves. Here every colour
+    is encoded, so PVR decodes it to VTK's number, at every integer scalar
+    (PVR interpolates colours in encoded values between points: with points
+    one scalar apart that bends the colour by ~1e-5). Opacity and everything
+    else are the peer scene's. The volume is the one beside OUT."""
+    meta = peer_meta()
+    opacity, colour = pc.scaled_tf(meta)
+    points = []
+    for x in range(0, 256):
+        r, g, b = (srgb_encode(v) for v in piecewise_linear(colour, float(x)))
+        (a,) = piecewise_linear(opacity, float(x))
+        points.append([float("%.15g" % v) for v in (float(x), r, g, b, a)])
+    doc = json.loads(scene())
+    doc["volume"]["file"] = "peer_blobs_%d.json" % EDGE
+    doc["transfer_function"]["points"] = points
+    with open(out, "w") as fh:
+        json.dump(doc, fh, indent=1)
+        fh.write("\n")
+    print("wrote %s" % out)
+
+
 def volume(outdir):
     os.makedirs(outdir, exist_ok=True)
     stem = os.path.join(outdir, "volume_%d" % EDGE)
@@ -130,8 +163,10 @@ def main(argv):
         volume(argv[2])
     elif len(argv) == 2 and argv[1] == "scene":
         sys.stdout.write(scene())
+    elif len(argv) == 3 and argv[1] == "vtk-model":
+        vtk_model(argv[2])
     else:
-        sys.stderr.write("usage: peer_blobs.py volume OUTDIR | peer_blobs.py scene\n")
+        sys.stderr.write("usage: peer_blobs.py volume OUTDIR | peer_blobs.py scene | peer_blobs.py vtk-model OUT\n")
         return 2
     return 0
 

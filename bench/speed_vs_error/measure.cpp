@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string_view>
 
 #include <nlohmann/json.hpp>
@@ -208,6 +209,36 @@ double loadAverage1() {
   return load;
 }
 
+core::Image quantised8(const core::Image& image) {
+  core::Image out = image.toFullFrame();
+  auto byte = [](float v) { return std::round(std::clamp(v, 0.0f, 1.0f) * 255.0f) / 255.0f; };
+  for (core::Rgba& p : out.pixels()) p = {byte(p.r), byte(p.g), byte(p.b), 0.0f};
+  return out;
+}
+
+core::ImageError rgbError(const core::Image& test, const core::Image& reference) {
+  if (test.frameWidth() != reference.frameWidth() || test.frameHeight() != reference.frameHeight())
+    throw Error(ErrorCode::kInvalidArgument,
+                "rgbError: " + std::to_string(test.frameWidth()) + "x" + std::to_string(test.frameHeight()) +
+                    " against a reference of " + std::to_string(reference.frameWidth()) + "x" +
+                    std::to_string(reference.frameHeight()));
+  double sum = 0, worst = 0;
+  for (int y = 0; y < test.frameHeight(); ++y)
+    for (int x = 0; x < test.frameWidth(); ++x) {
+      const core::Rgba p = test.sample(x, y), q = reference.sample(x, y);
+      for (double d : {double(p.r) - q.r, double(p.g) - q.g, double(p.b) - q.b}) {
+        sum += d * d;
+        worst = std::isnan(d) ? std::numeric_limits<double>::infinity() : std::max(worst, std::abs(d));
+      }
+    }
+  core::ImageError e;
+  const double n = 3.0 * test.frameWidth() * test.frameHeight();
+  e.rmse = n > 0 ? std::sqrt(sum / n) : 0;
+  e.psnr = e.rmse > 0 ? 20.0 * std::log10(1.0 / e.rmse) : std::numeric_limits<double>::infinity();
+  e.maxAbs = worst;
+  return e;
+}
+
 RebuildTimes rebuildTimes(const BenchScene& scene, int repeats, core::ThreadPool& pool) {
   const core::Scene& s = scene.scene();
   const core::TransferFunctionSpec& tf = s.volumes.front().transfer;
@@ -245,7 +276,8 @@ CaseResult measureCase(const BenchScene& scene, const Case& c, const Reference& 
 
   // Error at the reference's size and view (this render also warms the caches).
   const core::Camera small(s.camera, reference.size.width, reference.size.height);
-  result.error = core::compareImages(renderer.render(small, options, pool), reference.image);
+  result.image = renderer.render(small, options, pool).toFullFrame();
+  result.error = core::compareImages(result.image, reference.image);
 
   // Timed frames at the scene's own size.
   std::vector<double> seconds;

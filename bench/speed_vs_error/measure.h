@@ -96,6 +96,7 @@ struct Timing {
 struct CaseResult {
   Timing timing;
   core::ImageError error;
+  core::Image image;  // the case rendered at the reference's size and view (for error)
   double load1 = 0;  // 1-minute load average when the case started
 };
 
@@ -116,6 +117,17 @@ CaseResult measureCase(const BenchScene& scene, const Case& c, const Reference& 
 core::CameraSpec azimuth(const core::CameraSpec& camera, double degrees);
 
 double loadAverage1();
+
+// Another renderer's frame against the same reference: an 8-bit RGB image
+// (VTK's PNG, composited over black) and ours made alike. A premultiplied
+// image over black is its RGB, so the reference's RGB is what a perfect
+// renderer would have drawn; alpha is not compared.
+//
+// (The other renderer's file is read by core::readPngCodes.)
+// The image over black, each channel rounded to 8 bits as a PNG would hold it.
+core::Image quantised8(const core::Image& image);
+// RMSE, PSNR and max abs error over the R, G and B channels only, full frame.
+core::ImageError rgbError(const core::Image& test, const core::Image& reference);
 
 // What a transfer-function change costs with pre-integration on: building
 // the pre-integration table alone, and the renderer's whole classify()

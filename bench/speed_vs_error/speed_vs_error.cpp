@@ -13,6 +13,14 @@
 //       The scene at its own settings only, the same figures, for scripts/demo.
 //       --orbit K times K frames turning the camera 5 degrees each about its
 //       view-up, the camera path of the VTK peer benchmark.
+//       --peer-png FILE compares another renderer's 8-bit RGB frame of the
+//       scene's own view (VTK's PNG, over black, at the reference's size:
+//       pass --error-size to match) with the same reference, beside ours
+//       rounded to 8 bits the same way (RGB only: bench::rgbError).
+//       --peer-model SCENE.json also compares that frame with the reference
+//       of SCENE, the same scene as the other renderer models it (VTK:
+//       bench/scenes/peer_blobs.py vtk-model), to tell its numerical error
+//       from the difference of models.
 //
 // Options: --threads N (2), --frames N (5), --error-size N (256: longer side of
 // the reference and of the images compared with it), --substeps N (64: the
@@ -31,6 +39,7 @@
 #include <vector>
 
 #include "error.h"
+#include "image_io.h"
 #include "measure.h"
 
 namespace {
@@ -54,6 +63,8 @@ const char* const kDefaultScenes[] = {
 
 struct Args {
   std::string quick;
+  std::string peerPng;  // --quick: another renderer's frame to compare (--peer-png)
+  std::string peerModel;  // --quick: the scene as that renderer models it (--peer-model)
   std::vector<std::string> scenes;
   std::vector<double> steps{2, 1, 0.5, 0.25, 0.125};
   int threads = 2, frames = 5, orbit = 0;
@@ -68,7 +79,7 @@ struct Args {
                "usage: speed_vs_error [--threads N] [--frames N] [--error-size N] [--substeps N]\n"
                "                      [--steps A,B,...] [--case-seconds S] [--csv PATH]\n"
                "                      [--cache DIR | --no-cache] [SCENE.json ...]\n"
-               "       speed_vs_error --quick SCENE.json [--orbit K] [same options]\n",
+               "       speed_vs_error --quick SCENE.json [--orbit K] [--peer-png FILE [--peer-model SCENE.json]] [same options]\n",
                why.c_str());
   std::exit(2);
 }
@@ -103,6 +114,8 @@ Args parseArgs(int argc, char** argv) {
       else if (arg == "--threads") a.threads = positive(value());
       else if (arg == "--frames") a.frames = positive(value());
       else if (arg == "--orbit") a.orbit = positive(value());
+      else if (arg == "--peer-png") a.peerPng = value();
+      else if (arg == "--peer-model") a.peerModel = value();
       else if (arg == "--case-seconds") a.caseSeconds = std::stod(value());
       else if (arg == "--error-size") a.reference.maxEdge = positive(value());
       else if (arg == "--substeps") a.reference.substeps = positive(value());
@@ -118,6 +131,8 @@ Args parseArgs(int argc, char** argv) {
   }
   if (!a.quick.empty() && !a.scenes.empty()) usage("--quick takes one scene; no other scene files");
   if (a.quick.empty() && a.orbit > 0) usage("--orbit goes with --quick");
+  if (a.quick.empty() && !a.peerPng.empty()) usage("--peer-png goes with --quick");
+  if (a.peerPng.empty() && !a.peerModel.empty()) usage("--peer-model goes with --peer-png");
   if (a.scenes.empty())
     for (const char* s : kDefaultScenes) a.scenes.push_back(std::string(PVR_SOURCE_DIR) + "/" + s);
   return a;
@@ -168,6 +183,32 @@ int runQuick(const Args& args) {
               t.samplesPerSecond() * 1e-6, t.samplesPerSecond() * 1e-6 / pool.size(), pool.size());
   std::printf("  error vs reference RMSE %.3e, PSNR %.2f dB, max abs %.3e (linear RGBA at %dx%d)\n",
               r.error.rmse, r.error.psnr, r.error.maxAbs, ref.size.width, ref.size.height);
+  if (!args.peerPng.empty()) {
+    // Both as 8-bit RGB over black against the reference's RGB, same pixels.
+    const core::Image peer = core::readPngCodes(args.peerPng);
+    if (peer.frameWidth() != ref.size.width || peer.frameHeight() != ref.size.height)
+      throw Error(ErrorCode::kInvalidArgument,
+                  args.peerPng + ": " + std::to_string(peer.frameWidth()) + "x" + std::to_string(peer.frameHeight()) +
+                      ", the reference is " + std::to_string(ref.size.width) + "x" +
+                      std::to_string(ref.size.height) + " (--error-size)");
+    const core::ImageError theirs = bench::rgbError(peer, ref.image);
+    const core::ImageError ours8 = bench::rgbError(bench::quantised8(r.image), ref.image);
+    const core::ImageError ours = bench::rgbError(r.image, ref.image);
+    std::printf("  peer frame error   RMSE %.3e, PSNR %.2f dB, max abs %.3e (%s, 8-bit RGB at %dx%d)\n",
+                theirs.rmse, theirs.psnr, theirs.maxAbs, args.peerPng.c_str(), ref.size.width, ref.size.height);
+    std::printf("  our 8-bit error    RMSE %.3e, PSNR %.2f dB, max abs %.3e (ours rounded to 8-bit RGB alike)\n",
+                ours8.rmse, ours8.psnr, ours8.maxAbs);
+    std::printf("  our RGB error      RMSE %.3e, PSNR %.2f dB, max abs %.3e (float RGB, not rounded)\n",
+                ours.rmse, ours.psnr, ours.maxAbs);
+    if (!args.peerModel.empty()) {
+      const BenchScene model(args.peerModel);
+      const Reference modelRef = bench::computeReference(model, args.reference, pool);
+      const core::ImageError own = bench::rgbError(peer, modelRef.image);
+      std::printf("  peer model error   RMSE %.3e, PSNR %.2f dB, max abs %.3e (the peer frame against the "
+                  "reference of its own model, %s; reference took %.1f s)\n",
+                  own.rmse, own.psnr, own.maxAbs, shortName(args.peerModel).c_str(), modelRef.seconds);
+    }
+  }
   return 0;
 }
 

@@ -174,6 +174,7 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
   const float d0 = float(ray.step[0]), d1 = float(ray.step[1]), d2 = float(ray.step[2]);
   kernel::Accumulator acc;
   std::int64_t done = first;  // next sample not yet composited or skipped
+  const std::int64_t chunk = kernel::visibleChunk(ray);
   std::int64_t k = first;
   while (k <= last) {
     // Which macrocell holds sample k?
@@ -196,7 +197,7 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
     // run on into an empty macrocell add nothing, and a chunk costs one
     // look-up where walking the visible macrocells exactly (a 3D DDA)
     // mispredicted a branch at nearly every macrocell face.
-    const std::int64_t exit = std::min(last + 1, k + kernel::kVisibleChunk);
+    const std::int64_t exit = std::min(last + 1, k + chunk);
     // A pre-integrated segment runs from one sample to the next: when the
     // sample before this run was skipped, its segment ends in here.
     std::int64_t start = k;

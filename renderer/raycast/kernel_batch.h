@@ -4,9 +4,10 @@
 // position, cell, fraction, index and interpolation arithmetic that does
 // not depend on the other samples; here eight samples share each of those
 // instructions. Voxels are fetched with scalar loads (this machine's
-// hardware gathers cost ~19 cycles each, slower than loads), the table
-// entries and the "over" stay per sample, in the same order and precision
-// as the scalar loop.
+// hardware gathers cost ~19 cycles each, slower than loads). Plain
+// classification and compositing take the eight samples together as well
+// (kernel_batch_over.h); the pre-integrated batch composites its segments
+// one at a time, in the same order and precision as the scalar loop.
 #pragma once
 
 #if defined(__AVX2__) && defined(__FMA__)
@@ -21,6 +22,7 @@
 #include "kernel.h"
 #include "preint_lanes.h"
 #include "preint_lighting.h"
+#include "kernel_batch_over.h"
 
 namespace pvr::core::kernel {
 
@@ -66,11 +68,16 @@ template <typename T>
 // Samples [start, exit) of a visible run, eight at a time while eight
 // remain; `start` advances past what was done, the caller takes the rest
 // one at a time. Plain (not pre-integrated) classification; needs voxel
-// indices that fit 32 bits (KernelParams::indices32). Returns true when the
-// ray reached the early-termination opacity.
+// indices that fit 32 bits (KernelParams::indices32). A batch whose eight
+// table coordinates all lie in the transfer function's transparent ends
+// (KernelParams::clearBelow, clearAbove) stops after the reconstruction;
+// the others are classified and composited with each other first, then
+// into the ray (kernel_batch_over.h). Returns true when the ray reached the
+// early-termination opacity, tested after each batch.
 template <typename T, bool kShaded>
 inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
                        std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
+  if (start + 8 > exit) return false;
   const T* v = static_cast<const T*>(p.voxels);
   const float o[3] = {float(ray.origin[0]), float(ray.origin[1]), float(ray.origin[2])};
   const float d[3] = {float(ray.step[0]), float(ray.step[1]), float(ray.step[2])};
@@ -83,7 +90,10 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
   const __m256 scale = _mm256_set1_ps(p.tableScale), offset = _mm256_set1_ps(p.tableOffset);
   const __m256 tableLast = _mm256_set1_ps(float(p.tableEntries - 1));
   const __m256i entryLast = _mm256_set1_epi32(p.tableEntries - 2);
+  const __m256 clearBelow = _mm256_set1_ps(p.clearBelow), clearAbove = _mm256_set1_ps(p.clearAbove);
   const std::int64_t sy = p.strideY, sz = p.strideZ;
+  __m256d gathered = _mm256_setr_pd(acc.r, acc.g, acc.b, acc.a);
+  bool terminated = false;
 
   for (std::int64_t s = start; s + 8 <= exit; s += 8, start = s) {
     // Positions, cells and fractions of samples s .. s+7.
@@ -109,36 +119,51 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
     loadPairs8(v, index, sy + sz, e0, e1);
     const __m256 value = lerp8(lerp8(lerp8(a0, a1, fx), lerp8(b0, b1, fx), fy),
                                lerp8(lerp8(c0, c1, fx), lerp8(e0, e1, fx), fy), fz);
-    // Table coordinates; a non-finite value is made transparent below.
-    __m256 x = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(value, scale, offset), _mm256_setzero_ps()),
-                             tableLast);
-    const __m256i entry = _mm256_min_epi32(_mm256_cvttps_epi32(x), entryLast);
-    const __m256 weight = _mm256_sub_ps(x, _mm256_cvtepi32_ps(entry));
-    alignas(32) std::int32_t e[8];
-    alignas(32) float w[8], finite[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(e), entry);
-    _mm256_store_ps(w, weight);
+    samples += 8;
+    // Table coordinates (a NaN becomes 0: max returns its second operand).
+    const __m256 x = _mm256_min_ps(
+        _mm256_max_ps(_mm256_fmadd_ps(value, scale, offset), _mm256_setzero_ps()), tableLast);
+    // Lanes that classify as transparent; a non-finite value is one of them.
+    __m256 clear = _mm256_or_ps(_mm256_cmp_ps(x, clearBelow, _CMP_LT_OQ), _mm256_cmp_ps(x, clearAbove, _CMP_GE_OQ));
+    __m256 finite = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
     if constexpr (std::is_floating_point_v<T>) {
       const __m256 magnitude = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), value);
-      _mm256_store_ps(finite, _mm256_cmp_ps(magnitude, _mm256_set1_ps(FLT_MAX), _CMP_LE_OQ));
+      finite = _mm256_cmp_ps(magnitude, _mm256_set1_ps(FLT_MAX), _CMP_LE_OQ);
+      clear = _mm256_or_ps(clear, _mm256_andnot_ps(finite, _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
     }
-    // Classify and composite in sample order, as the scalar loop does.
-    for (int lane = 0; lane < 8; ++lane) {
-      Rgba c = lerp(p.table[e[lane]], p.table[e[lane] + 1], w[lane]);
-      if constexpr (std::is_floating_point_v<T>) {
-        if (finite[lane] == 0.0f) c = Rgba{};
-      }
-      if constexpr (kShaded) {
-        if (!(c.a > 0)) continue;
-        const float t = float(s + lane);
-        c = shade(v, p, ray, o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2], c);
-      }
-      acc.addBehind(c);
+    if (_mm256_movemask_ps(clear) == 0xFF) continue;
+    // Classify.
+    const __m256i entry = _mm256_min_epi32(_mm256_cvttps_epi32(x), entryLast);
+    Quads c = classifyQuads(p.table, entry, _mm256_sub_ps(x, _mm256_cvtepi32_ps(entry)));
+    if constexpr (std::is_floating_point_v<T>) keepQuads(c, finite);
+    if constexpr (kShaded) {
+      // Light each visible sample; quad j holds samples j and j + 4.
+      alignas(32) Rgba lit[8];
+      for (int q = 0; q < 4; ++q) _mm256_store_ps(&lit[2 * q].r, c.q[q]);
+      for (int q = 0; q < 4; ++q)
+        for (int h = 0; h < 2; ++h) {
+          Rgba& one = lit[2 * q + h];
+          if (!(one.a > 0)) continue;
+          const float t = float(s + q + 4 * h);
+          one = shade(v, p, ray, o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2], one);
+        }
+      for (int q = 0; q < 4; ++q) c.q[q] = _mm256_load_ps(&lit[2 * q].r);
     }
-    samples += 8;
-    if (acc.a >= p.earlyTermination) return true;
+    // Composite the batch, then the batch into the ray.
+    gathered = addBehind4(gathered, overQuads(c));
+    if (_mm256_cvtsd_f64(_mm256_permute4x64_pd(gathered, 0xFF)) >= p.earlyTermination) {
+      start = s + 8;
+      terminated = true;
+      break;
+    }
   }
-  return false;
+  alignas(32) double out[4];
+  _mm256_store_pd(out, gathered);
+  acc.r = out[0];
+  acc.g = out[1];
+  acc.b = out[2];
+  acc.a = out[3];
+  return terminated;
 }
 
 // The scalars at samples [first, first + 8) as `around` reads them

@@ -1,6 +1,7 @@
 #include "kernel_setup.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 
 namespace pvr::core {
@@ -48,6 +49,19 @@ void setTables(KernelParams& p, const TransferTable& table, const PreintegratedT
   p.tableEntries = TransferTable::kEntries;
   p.tableScale = table.scale();
   p.tableOffset = table.offset();
+  // The transparent ends of the table: entries before the first and after
+  // the last that has any non-zero channel.
+  const Rgba* e = table.entries();
+  const int n = TransferTable::kEntries;
+  auto zero = [](const Rgba& c) { return c.r == 0 && c.g == 0 && c.b == 0 && c.a == 0; };
+  int first = 0, last = n - 1;
+  while (first < n && zero(e[first])) ++first;
+  while (last >= 0 && zero(e[last])) --last;
+  // classify1D reads entries i and i + 1, i = min(int(x), n - 2): both are
+  // zero when i + 1 < first, i.e. x < first - 1, or when i > last, i.e.
+  // x >= last + 1 with last + 1 <= n - 2.
+  p.clearBelow = first == n ? FLT_MAX : float(first - 1);
+  p.clearAbove = first == n || last + 1 > n - 2 ? FLT_MAX : float(last + 1);
   p.preint = preintegrated ? preintegrated->tables() : PreintegralTables{};
   p.stepLength = step;
 }

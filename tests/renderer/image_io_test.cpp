@@ -168,6 +168,32 @@ TEST_CASE("PNG over a translucent background keeps straight alpha", "[image]") {
   CHECK(std::vector<std::uint8_t>(c.begin() + 4, c.end()) == std::vector<std::uint8_t>{51, 102, 153, 255});
 }
 
+// Another program's PNG read number for number: the code values / 255,
+// neither decoded from sRGB nor multiplied by alpha (the second pixel's
+// alpha is 128 and its colour still reads as stored).
+TEST_CASE("readPngCodes gives a PNG's code values over 255", "[image]") {
+  Image image(3, 1, {0, 0, 2, 1});
+  image.at(0, 0) = {0.5f, 0.18f, 1.0f, 1.0f};  // encodes to 188, 118, 255
+  image.at(1, 0) = {0.25f, 0.25f, 0.25f, 0.5f};  // straight 0.5 -> 188, alpha 128
+  const std::string path = scratch("codes.png").string();
+  writePng(image, {0, 0, 0, 0}, path);
+  const Image codes = readPngCodes(path);
+  REQUIRE(codes.frameWidth() == 3);
+  REQUIRE(codes.frameHeight() == 1);
+  CHECK(codes.at(0, 0).r == 188 / 255.0f);
+  CHECK(codes.at(0, 0).g == 118 / 255.0f);
+  CHECK(codes.at(0, 0).b == 1.0f);
+  CHECK(codes.at(1, 0).r == 188 / 255.0f);
+  CHECK(codes.at(1, 0).a == 0.0f);
+  CHECK(codes.at(2, 0).r == 0.0f);
+
+  const std::string missing = scratch("missing.png").string();
+  CHECK(errorOf([](const std::string& p) { readPngCodes(p); }, missing).rfind(missing + ": cannot read", 0) == 0);
+  const std::string exr = scratch("not_png.exr").string();
+  writeExr(image, exr);
+  CHECK(errorOf([](const std::string& p) { readPngCodes(p); }, exr).rfind(exr + ": not a PNG file", 0) == 0);
+}
+
 TEST_CASE("image file errors name the path", "[image]") {
   const Image image = Image::fullFrame(2, 2);
   const std::string jpg = scratch("frame.jpg").string();
