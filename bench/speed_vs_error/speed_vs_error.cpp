@@ -17,9 +17,14 @@
 // Options: --threads N (2), --frames N (5), --error-size N (256: longer side of
 // the reference and of the images compared with it), --substeps N (64: the
 // reference's dt is the smallest spacing / N, at most the scene step / 16),
-// --steps LIST (voxels, comma-separated), --case-seconds S (sweep: stop timing
+// --steps LIST (voxels, comma-separated), --quality LIST (dB, comma-separated:
+// per scene and target, sampling.target_psnr at the scene's step, its
+// achieved PSNR and time beside the time of a uniform step of the same
+// error, interpolated from the sweep, which then runs plain sampling with
+// skipping only), --case-seconds S (sweep: stop timing
 // a case once its frames add up to S seconds, after at least one; the CSV
 // says how many frames each median has), --csv PATH, --cache DIR, --no-cache.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -56,6 +61,7 @@ struct Args {
   std::string quick;
   std::vector<std::string> scenes;
   std::vector<double> steps{2, 1, 0.5, 0.25, 0.125};
+  std::vector<double> quality;  // target PSNRs, dB
   int threads = 2, frames = 5, orbit = 0;
   double caseSeconds = 0;  // sweep: stop timing a case after this long (0 = never)
   bench::ReferenceSettings reference{256, 64, 16, PVR_BENCH_CACHE};
@@ -66,22 +72,22 @@ struct Args {
   std::fprintf(stderr,
                "speed_vs_error: %s\n"
                "usage: speed_vs_error [--threads N] [--frames N] [--error-size N] [--substeps N]\n"
-               "                      [--steps A,B,...] [--case-seconds S] [--csv PATH]\n"
+               "                      [--steps A,B,...] [--quality DB,DB,...] [--case-seconds S] [--csv PATH]\n"
                "                      [--cache DIR | --no-cache] [SCENE.json ...]\n"
                "       speed_vs_error --quick SCENE.json [--orbit K] [same options]\n",
                why.c_str());
   std::exit(2);
 }
 
-std::vector<double> parseList(const std::string& text) {
+std::vector<double> parseList(const std::string& option, const std::string& text) {
   std::vector<double> out;
   std::stringstream in(text);
   for (std::string item; std::getline(in, item, ',');) {
     const double v = std::stod(item);
-    if (!(v > 0)) usage("--steps: every step must be > 0");
+    if (!(v > 0)) usage(option + ": every value must be > 0");
     out.push_back(v);
   }
-  if (out.empty()) usage("--steps: no steps");
+  if (out.empty()) usage(option + ": no values");
   return out;
 }
 
@@ -106,7 +112,8 @@ Args parseArgs(int argc, char** argv) {
       else if (arg == "--case-seconds") a.caseSeconds = std::stod(value());
       else if (arg == "--error-size") a.reference.maxEdge = positive(value());
       else if (arg == "--substeps") a.reference.substeps = positive(value());
-      else if (arg == "--steps") a.steps = parseList(value());
+      else if (arg == "--steps") a.steps = parseList(arg, value());
+      else if (arg == "--quality") a.quality = parseList(arg, value());
       else if (arg == "--csv") a.csv = value();
       else if (arg == "--cache") a.reference.cacheDir = value();
       else if (arg == "--no-cache") a.reference.cacheDir.clear();
@@ -181,16 +188,19 @@ std::vector<SweepCase> sweepCases(const Args& args, const BenchScene& scene) {
   const Case own = bench::ownCase(scene.scene());
   std::vector<SweepCase> cases;
   bool ownFound = false;
+  // With --quality, the uniform steps the targets are compared with only.
+  const std::vector<bool> pres = args.quality.empty() ? std::vector<bool>{false, true} : std::vector<bool>{false};
+  const std::vector<bool> skips = args.quality.empty() ? std::vector<bool>{true, false} : std::vector<bool>{true};
   for (double steps : args.steps)
-    for (bool pre : {false, true})
-      for (bool skip : {true, false}) {
+    for (bool pre : pres)
+      for (bool skip : skips) {
         const Case c{steps * scene.voxel(), pre, skip};
         const bool isOwn = std::abs(c.step - own.step) <= 1e-6 * own.step &&
                            pre == own.preintegrated && skip == own.skipEmpty;
         ownFound |= isOwn;
         cases.push_back({c, isOwn});
       }
-  if (!ownFound) cases.push_back({own, true});
+  if (!ownFound && args.quality.empty()) cases.push_back({own, true});
   return cases;
 }
 
@@ -209,7 +219,7 @@ class CsvWriter {
     out_ << "scene,volume,shaded,step_voxels,step_world,preintegrated,skipping,scene_default,"
             "threads,width,height,frames,median_s,min_s,max_s,samples_per_frame,msamples_per_s,"
             "msamples_per_s_per_core,error_width,error_height,rmse,psnr_db,max_abs,"
-            "reference_dt_voxels,load1\n";
+            "reference_dt_voxels,load1,target_psnr_db\n";
   }
   void row(const BenchScene& scene, const SweepCase& sc, const CaseResult& r, const Reference& ref,
            int threads) {
@@ -218,7 +228,7 @@ class CsvWriter {
     char line[1024];
     std::snprintf(line, sizeof line,
                   "%s,%s,%d,%.6g,%.6g,%d,%d,%d,%d,%d,%d,%d,%.6f,%.6f,%.6f,%.0f,%.3f,%.3f,%d,%d,"
-                  "%.6e,%.3f,%.6e,%.6g,%.2f\n",
+                  "%.6e,%.3f,%.6e,%.6g,%.2f,%.6g\n",
                   csvField(shortName(scene.path())).c_str(), csvField(scene.describe()).c_str(),
                   int(s.shading.enabled), sc.c.step / scene.voxel(), sc.c.step,
                   int(sc.c.preintegrated), int(sc.c.skipEmpty),
@@ -226,7 +236,7 @@ class CsvWriter {
                   t.max, t.frames > 0 ? double(t.samples) / t.frames : 0.0,
                   t.samplesPerSecond() * 1e-6, t.samplesPerSecond() * 1e-6 / threads,
                   ref.size.width, ref.size.height, r.error.rmse, r.error.psnr, r.error.maxAbs,
-                  ref.dt / scene.voxel(), r.load1);
+                  ref.dt / scene.voxel(), r.load1, sc.c.targetPsnr);
     out_ << line;
     out_.flush();
   }
@@ -275,6 +285,52 @@ void printPreintegration(const std::vector<SweepRow>& rows, const bench::Rebuild
   }
 }
 
+// The time of a uniform step (plain, skipping on) whose error is `psnr`,
+// interpolated from the sweep's rows: log time linear in PSNR between the
+// two rows around it; 0 when the sweep does not reach that PSNR.
+double uniformTimeAt(const std::vector<SweepRow>& rows, double psnr) {
+  std::vector<std::pair<double, double>> curve;  // (PSNR, seconds)
+  for (const SweepRow& row : rows)
+    if (row.sc.c.targetPsnr == 0 && !row.sc.c.preintegrated && row.sc.c.skipEmpty)
+      curve.emplace_back(row.r.error.psnr, row.r.timing.median);
+  std::sort(curve.begin(), curve.end());
+  for (std::size_t i = 0; i + 1 < curve.size(); ++i) {
+    const auto [p0, t0] = curve[i];
+    const auto [p1, t1] = curve[i + 1];
+    if (psnr < p0 || psnr > p1 || !(p1 > p0)) continue;
+    const double w = (psnr - p0) / (p1 - p0);
+    return std::exp(std::log(t0) + w * (std::log(t1) - std::log(t0)));
+  }
+  return 0;
+}
+
+// Quality chosen by error: each target at the scene's step, its achieved
+// error and time, and what a uniform step of that error costs.
+void runQuality(const Args& args, const BenchScene& scene, const Reference& ref, std::vector<SweepRow>& rows,
+                CsvWriter& csv, core::ThreadPool& pool) {
+  std::printf("  quality chosen by error (sampling.target_psnr at step %.3g voxel, plain, skipping on):\n",
+              scene.scene().sampling.step / scene.voxel());
+  std::printf("  %-9s %9s %-4s %9s %12s %9s %13s %5s\n", "target dB", "PSNR dB", "met", "s/frame",
+              "samples", "uniform s", "target/unif.", "load");
+  for (double target : args.quality) {
+    const SweepCase sc{{scene.scene().sampling.step, false, true, target}, false};
+    const CaseResult r = bench::measureCase(scene, sc.c, ref, args.frames, args.caseSeconds, 0, pool);
+    const double uniform = uniformTimeAt(rows, r.error.psnr);
+    char uniformText[32] = "-", ratio[32] = "-";
+    if (uniform > 0) {
+      std::snprintf(uniformText, sizeof uniformText, "%.4f", uniform);
+      std::snprintf(ratio, sizeof ratio, "%.2f", r.timing.median / uniform);
+    }
+    std::printf("  %-9.4g %9.2f %-4s %9.4f %12.0f %9s %13s %5.2f\n", target, r.error.psnr,
+                r.error.psnr >= target ? "yes" : "NO", r.timing.median,
+                r.timing.frames > 0 ? double(r.timing.samples) / r.timing.frames : 0.0, uniformText, ratio,
+                r.load1);
+    std::fflush(stdout);
+    csv.row(scene, sc, r, ref, pool.size());
+    rows.push_back({sc, r});
+  }
+}
+
 int runSweep(const Args& args) {
   core::ThreadPool pool(args.threads);
   fs::create_directories(fs::path(args.csv).parent_path());
@@ -307,7 +363,8 @@ int runSweep(const Args& args) {
       csv.row(scene, sc, r, ref, pool.size());
       rows.push_back({sc, r});
     }
-    printPreintegration(rows, bench::rebuildTimes(scene, 9, pool), scene.voxel());
+    if (args.quality.empty()) printPreintegration(rows, bench::rebuildTimes(scene, 9, pool), scene.voxel());
+    else runQuality(args, scene, ref, rows, csv, pool);
   }
   std::printf("\nwrote %s\n", args.csv.c_str());
   return 0;
