@@ -285,46 +285,57 @@ void printPreintegration(const std::vector<SweepRow>& rows, const bench::Rebuild
   }
 }
 
-// The time of a uniform step (plain, skipping on) whose error is `psnr`,
-// interpolated from the sweep's rows: log time linear in PSNR between the
-// two rows around it; 0 when the sweep does not reach that PSNR.
-double uniformTimeAt(const std::vector<SweepRow>& rows, double psnr) {
-  std::vector<std::pair<double, double>> curve;  // (PSNR, seconds)
+// What a uniform step (plain, skipping on) whose error is `psnr` costs,
+// interpolated from the sweep's rows: log time and log samples per frame
+// linear in PSNR between the two rows around it; zeros when the sweep does
+// not reach that PSNR.
+struct UniformCost {
+  double seconds = 0, samples = 0;
+};
+UniformCost uniformCostAt(const std::vector<SweepRow>& rows, double psnr) {
+  struct Point {
+    double psnr, seconds, samples;
+  };
+  std::vector<Point> curve;
   for (const SweepRow& row : rows)
-    if (row.sc.c.targetPsnr == 0 && !row.sc.c.preintegrated && row.sc.c.skipEmpty)
-      curve.emplace_back(row.r.error.psnr, row.r.timing.median);
-  std::sort(curve.begin(), curve.end());
+    if (row.sc.c.targetPsnr == 0 && !row.sc.c.preintegrated && row.sc.c.skipEmpty && row.r.timing.frames > 0)
+      curve.push_back({row.r.error.psnr, row.r.timing.median, double(row.r.timing.samples) / row.r.timing.frames});
+  std::sort(curve.begin(), curve.end(), [](const Point& a, const Point& b) { return a.psnr < b.psnr; });
   for (std::size_t i = 0; i + 1 < curve.size(); ++i) {
-    const auto [p0, t0] = curve[i];
-    const auto [p1, t1] = curve[i + 1];
-    if (psnr < p0 || psnr > p1 || !(p1 > p0)) continue;
-    const double w = (psnr - p0) / (p1 - p0);
-    return std::exp(std::log(t0) + w * (std::log(t1) - std::log(t0)));
+    const Point& a = curve[i];
+    const Point& b = curve[i + 1];
+    if (psnr < a.psnr || psnr > b.psnr || !(b.psnr > a.psnr)) continue;
+    const double w = (psnr - a.psnr) / (b.psnr - a.psnr);
+    auto mix = [w](double x, double y) { return std::exp(std::log(x) + w * (std::log(y) - std::log(x))); };
+    return {mix(a.seconds, b.seconds), mix(a.samples, b.samples)};
   }
-  return 0;
+  return {};
 }
 
 // Quality chosen by error: each target at the scene's step, its achieved
-// error and time, and what a uniform step of that error costs.
+// error, time and samples, and what a uniform step of that error costs
+// (time and samples, and the target's cost over it: "x" < 1 is cheaper).
 void runQuality(const Args& args, const BenchScene& scene, const Reference& ref, std::vector<SweepRow>& rows,
                 CsvWriter& csv, core::ThreadPool& pool) {
   std::printf("  quality chosen by error (sampling.target_psnr at step %.3g voxel, plain, skipping on):\n",
               scene.scene().sampling.step / scene.voxel());
-  std::printf("  %-9s %9s %-4s %9s %12s %9s %13s %5s\n", "target dB", "PSNR dB", "met", "s/frame",
-              "samples", "uniform s", "target/unif.", "load");
+  std::printf("  %-9s %9s %-4s %9s %12s %9s %12s %8s %8s %5s\n", "target dB", "PSNR dB", "met", "s/frame",
+              "samples", "uniform s", "uniform samp", "time x", "samp x", "load");
   for (double target : args.quality) {
     const SweepCase sc{{scene.scene().sampling.step, false, true, target}, false};
     const CaseResult r = bench::measureCase(scene, sc.c, ref, args.frames, args.caseSeconds, 0, pool);
-    const double uniform = uniformTimeAt(rows, r.error.psnr);
-    char uniformText[32] = "-", ratio[32] = "-";
-    if (uniform > 0) {
-      std::snprintf(uniformText, sizeof uniformText, "%.4f", uniform);
-      std::snprintf(ratio, sizeof ratio, "%.2f", r.timing.median / uniform);
+    const UniformCost uniform = uniformCostAt(rows, r.error.psnr);
+    const double samples = r.timing.frames > 0 ? double(r.timing.samples) / r.timing.frames : 0.0;
+    char text[4][32] = {"-", "-", "-", "-"};
+    if (uniform.seconds > 0) {
+      std::snprintf(text[0], sizeof text[0], "%.4f", uniform.seconds);
+      std::snprintf(text[1], sizeof text[1], "%.0f", uniform.samples);
+      std::snprintf(text[2], sizeof text[2], "%.2f", r.timing.median / uniform.seconds);
+      std::snprintf(text[3], sizeof text[3], "%.2f", samples / uniform.samples);
     }
-    std::printf("  %-9.4g %9.2f %-4s %9.4f %12.0f %9s %13s %5.2f\n", target, r.error.psnr,
-                r.error.psnr >= target ? "yes" : "NO", r.timing.median,
-                r.timing.frames > 0 ? double(r.timing.samples) / r.timing.frames : 0.0, uniformText, ratio,
-                r.load1);
+    std::printf("  %-9.4g %9.2f %-4s %9.4f %12.0f %9s %12s %8s %8s %5.2f\n", target, r.error.psnr,
+                r.error.psnr >= target ? "yes" : "NO", r.timing.median, samples, text[0], text[1], text[2],
+                text[3], r.load1);
     std::fflush(stdout);
     csv.row(scene, sc, r, ref, pool.size());
     rows.push_back({sc, r});
