@@ -21,7 +21,7 @@
 // per scene and target, sampling.target_psnr at the scene's step, its
 // achieved PSNR and time beside the time of a uniform step of the same
 // error, interpolated from the sweep, which then runs plain sampling with
-// skipping only), --case-seconds S (sweep: stop timing
+// skipping only; quality.sh runs it on every scene), --case-seconds S (sweep: stop timing
 // a case once its frames add up to S seconds, after at least one; the CSV
 // says how many frames each median has), --csv PATH, --cache DIR, --no-cache.
 #include <algorithm>
