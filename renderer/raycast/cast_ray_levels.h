@@ -60,14 +60,17 @@ inline int levelAt(const KernelParams& p, const RaySetup& ray, double k) {
   return p.levels[index];
 }
 
-// Block b's level: the finest at its start, middle and end; fine (0) at the
-// chord's ends.
+// Block b's level: at its middle (the field is eroded by a block's reach,
+// StepLevels::choose); fine (0) at the chord's ends.
 inline int blockLevel(const KernelParams& p, const RaySetup& ray, const ChordEnds& ends, std::int64_t b) {
   const std::int64_t lo = b << kLevelBlockShift, hi = lo + kLevelBlock - 1;
   if ((ends.first >= lo && ends.first <= hi) || (ends.last >= lo && ends.last <= hi)) return 0;
-  return std::min({levelAt(p, ray, double(lo)), levelAt(p, ray, double(lo + kLevelBlock / 2)),
-                   levelAt(p, ray, double(hi))});
+  return levelAt(p, ray, double(lo + kLevelBlock / 2));
 }
+
+// Blocks a chunk may join when they take the same level: a chunk is
+// marched without looking at empty space again.
+inline constexpr std::int64_t kBlocksPerChunk = 4;
 
 }  // namespace kernel
 
@@ -103,7 +106,8 @@ RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShif
     const std::int64_t block = k >> kLevelBlockShift, blockEnd = (block + 1) << kLevelBlockShift;
     const int level = kernel::blockLevel(p, ray, ends, block);
     if (level == 0) {
-      const std::int64_t exit = std::min({last + 1, k + kernel::kVisibleChunk, blockEnd});
+      std::int64_t exit = std::min(last + 1, k + kernel::kVisibleChunk);
+      if (exit > blockEnd && kernel::blockLevel(p, ray, ends, block + 1) != 0) exit = blockEnd;
       if (kernel::runSpan<T, kShaded, false>(p, ray, ends, k, exit, acc, out.samples)) break;
       k = exit;
       continue;
@@ -113,14 +117,20 @@ RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShif
       coarseSet[level] = true;
     }
     // The block's coarse samples from k on that this brick owns (theirs
-    // are fine samples in [k, last]), a chunk at a time.
+    // are fine samples in [k, last]), with those of the next blocks of the
+    // same level, a chunk at a time.
     const std::int64_t start = kernel::coarseFrom(k, level);
+    std::int64_t runEnd = blockEnd;
+    while (runEnd <= last && runEnd - blockEnd < (kernel::kBlocksPerChunk - 1) * kLevelBlock &&
+           (runEnd >> level) - start < kernel::kVisibleChunk &&
+           kernel::blockLevel(p, ray, ends, runEnd >> kLevelBlockShift) == level)
+      runEnd += kLevelBlock;
     const std::int64_t exit =
-        std::min({kernel::coarseFrom(last + 1, level), blockEnd >> level, start + kernel::kVisibleChunk});
+        std::min({kernel::coarseFrom(last + 1, level), runEnd >> level, start + kernel::kVisibleChunk});
     if (start < exit &&
         kernel::runSpan<T, kShaded, false>(p.atLevel[level], coarse[level], noEnds, start, exit, acc, out.samples))
       break;
-    k = std::min(blockEnd, std::max(k + 1, kernel::fineOf(exit, level)));
+    k = std::min(runEnd, std::max(k + 1, kernel::fineOf(exit, level)));
   }
   out.colour = acc.rgba();
   return out;

@@ -19,10 +19,30 @@ constexpr int kSize = MacrocellLayout::kSize;
 // neighbour's jump counts as variation here.
 constexpr int kMargin = 1;
 
-// Index units a block reaches beyond an owned sample, rounded up: its
+// Index units from a block's middle to its ends, rounded up: half its
 // length at the fine step along the axis of the smallest spacing.
-std::int64_t blockReach(const GridGeometry& grid, double sceneStep) {
-  return std::int64_t(std::ceil(double(kLevelBlock) * fineStep(sceneStep) / grid.minSpacing() - 1e-9)) + 1;
+std::int64_t halfBlock(const GridGeometry& grid, double sceneStep) {
+  return std::int64_t(std::ceil(double(kLevelBlock / 2) * fineStep(sceneStep) / grid.minSpacing() - 1e-9)) + 1;
+}
+
+// Macrocells a block reaches from the one its middle lies in: the radius
+// by which the levels are eroded, so that the middle's level holds for the
+// whole block.
+std::int64_t blockSpread(const GridGeometry& grid, double sceneStep) {
+  return (halfBlock(grid, sceneStep) + kSize - 1) / kSize;
+}
+
+// out[i] = min of in[j] over |j - i| <= r within [0, n), along one axis
+// (element k of line `line` at base + k * stride).
+void erodeLine(std::uint8_t* v, std::int64_t n, std::int64_t stride, std::int64_t r, std::vector<std::uint8_t>& tmp) {
+  tmp.resize(std::size_t(n));
+  for (std::int64_t i = 0; i < n; ++i) tmp[std::size_t(i)] = v[i * stride];
+  for (std::int64_t i = 0; i < n; ++i) {
+    std::uint8_t m = tmp[std::size_t(i)];
+    for (std::int64_t j = std::max<std::int64_t>(0, i - r); j <= std::min(n - 1, i + r); ++j)
+      m = std::min(m, tmp[std::size_t(j)]);
+    v[i * stride] = m;
+  }
 }
 
 // Range queries over a table's entries in O(1): the max of [a, b] of one
@@ -53,7 +73,7 @@ class RangeMax {
 }  // namespace
 
 int levelGhostLayers(const GridGeometry& grid, double sceneStep) {
-  return int(blockReach(grid, sceneStep)) + kSize + kMargin;
+  return int(halfBlock(grid, sceneStep) + kSize * blockSpread(grid, sceneStep)) + kSize + kMargin;
 }
 
 double levelError(double steps, double variation, double slope, double entries) {
@@ -69,10 +89,10 @@ double levelBudget(double targetPsnr) {
   // The image's RMSE at the target is 10^(-PSNR/20) (peak 1). A pixel's
   // error adds up over the macrocells its ray crosses with variation, and
   // partly cancels; most pixels meet few. The share per macrocell crossing
-  // was calibrated on the bench scenes (bench/speed_vs_error --quality):
-  // at 1 every one meets 40, 50 and 60 dB (the shaded water density by
-  // 2 dB at 60; 4x the share missed it by 10 dB).
-  constexpr double kShare = 1.0;
+  // was calibrated on the bench scenes (bench/speed_vs_error/quality.sh):
+  // at 3 the shaded water density and CT head missed 60 dB (59.9, 59.4),
+  // at 1.5 every scene meets 40, 50 and 60 dB (bench/results/quality.txt).
+  constexpr double kShare = 1.5;
   return kShare * std::pow(10.0, -targetPsnr / 20.0);
 }
 
@@ -81,12 +101,15 @@ StepLevels::StepLevels(const Brick& brick, double sceneStep, ThreadPool* pool)
   const GridGeometry& grid = brick.grid();
   const NodeBox& own = brick.owned();
   const NodeBox& st = brick.stored();
-  const std::int64_t reach = blockReach(grid, sceneStep);
+  // Block middles lie within half a block of an owned sample; the levels
+  // there are eroded from blockSpread macrocells around them.
+  const std::int64_t reach = halfBlock(grid, sceneStep);
+  spread_ = blockSpread(grid, sceneStep);
   for (int a = 0; a < 3; ++a) {
     const std::int64_t cells = std::max<std::int64_t>(1, grid.dims[a] - 1);
     domainCount_[a] = (cells + kSize - 1) >> kShift;
-    first_[a] = std::max<std::int64_t>(0, (own.lo[a] - reach) >> kShift);
-    const std::int64_t last = std::min(domainCount_[a] - 1, (own.hi[a] + reach) >> kShift);
+    first_[a] = std::max<std::int64_t>(0, ((own.lo[a] - reach) >> kShift) - spread_);
+    const std::int64_t last = std::min(domainCount_[a] - 1, ((own.hi[a] + reach) >> kShift) + spread_);
     count_[a] = std::max<std::int64_t>(1, last - first_[a] + 1);
     // The nodes the last macrocell's range reads must be stored.
     const std::int64_t needLo = std::max<std::int64_t>(0, (first_[a] << kShift) - kMargin);
@@ -197,6 +220,14 @@ void StepLevels::choose(const TransferFunctionSpec& tf, double targetPsnr, doubl
     while (level > 0 && error(fine * double(1 << level)) > budget) --level;
     levels_[i] = std::uint8_t(level);
   }
+  // A block takes the level at its middle: the finest within its reach.
+  std::vector<std::uint8_t> line;
+  const std::int64_t nx = count_.x, ny = count_.y, nz = count_.z;
+  for (std::int64_t z = 0; z < nz; ++z)
+    for (std::int64_t y = 0; y < ny; ++y) erodeLine(&levels_[std::size_t((z * ny + y) * nx)], nx, 1, spread_, line);
+  for (std::int64_t z = 0; z < nz; ++z)
+    for (std::int64_t x = 0; x < nx; ++x) erodeLine(&levels_[std::size_t(z * ny * nx + x)], ny, nx, spread_, line);
+  for (std::int64_t y = 0; y < ny; ++y)
+    for (std::int64_t x = 0; x < nx; ++x) erodeLine(&levels_[std::size_t(y * nx + x)], nz, nx * ny, spread_, line);
 }
-
 }  // namespace pvr::core

@@ -10,10 +10,12 @@
 // samples, aligned to the global sample index, so that every brick that
 // holds part of a block takes the same samples in it (cast_ray_levels.h).
 //
-// The levels a block needs are read at points up to a block's length
-// outside the brick's owned box, so the field covers an extended layout of
-// macrocells, whose value ranges come from the stored voxels: the brick
-// needs levelGhostLayers() beyond its owned box (ghostLayers(), raycaster.h).
+// A block reads the level at its middle, and the levels are eroded (each
+// macrocell takes the finest within a block's reach), so that level holds
+// along the whole block. Middles lie up to half a block outside the
+// brick's owned box, so the field covers an extended layout of macrocells,
+// whose value ranges come from the stored voxels: the brick needs
+// levelGhostLayers() beyond its owned box (ghostLayers(), raycaster.h).
 #pragma once
 
 #include <cstdint>
@@ -35,8 +37,8 @@ inline constexpr std::int64_t kLevelBlock = std::int64_t(1) << kLevelBlockShift;
 inline double fineStep(double sceneStep) { return sceneStep / double(1 << kSceneStepLevel); }
 
 // Node layers the level field reads beyond a brick's owned box at this
-// scene step: a block's length, rounded up, plus a macrocell and the layer
-// around it that its value range includes.
+// scene step: half a block's length and the erosion's reach, rounded up,
+// plus a macrocell and the layer around it that its value range includes.
 int levelGhostLayers(const GridGeometry& grid, double sceneStep);
 
 class StepLevels {
@@ -49,7 +51,8 @@ class StepLevels {
 
   // Picks every macrocell's level for the transfer function (resolved) and
   // the target (dB, > 0): the coarsest whose modelled error (levelError)
-  // stays within the target's share of a macrocell. `shadingShare` is the
+  // stays within the target's share of a macrocell, then the finest of
+  // those within a block's reach. `shadingShare` is the
   // part of a sample's colour that shading varies (diffuse + specular; 0
   // unshaded).
   void choose(const TransferFunctionSpec& tf, double targetPsnr, double shadingShare);
@@ -67,6 +70,7 @@ class StepLevels {
   const Brick& brick_;
   double sceneStep_ = 0;
   IVec3 first_, count_, domainCount_;
+  std::int64_t spread_ = 0;       // the erosion's radius in macrocells
   std::vector<float> min_, max_;  // value range per macrocell (min > max: no finite node)
   std::vector<std::uint8_t> levels_;
 };
