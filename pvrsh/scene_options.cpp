@@ -277,6 +277,16 @@ void setTimestep(Apply& a) { a.scene({{"timestep", parseInteger(a.option, a.valu
 // (docs/runtime.md); the server checks the upper bound.
 void setCacheMemory(Apply& a) { a.scene({{"runtime", {{"cachemem", parseInteger(a.option, a.value, 0, INT32_MAX)}}}}); }
 
+// -quality DB: sampling.target_psnr (docs/scene.md), the PSNR the server
+// picks each region's step to meet; 0 turns it off. The server checks the
+// upper bound, as it checks every scene value.
+// Errors: {PVR ARGS QUALITY}.
+void setQuality(Apply& a) {
+  const double db = a.number();
+  if (!(db >= 0)) argsError("QUALITY", a.option + " must be a PSNR in dB, >= 0 (0 = off), got '" + a.value + "'");
+  setScalar(a, "sampling", "target_psnr", db);
+}
+
 // One row per option. `value` and `byDefault` are what `:s help set` and
 // `:s set` (no arguments) show: the value's form, and what is in force
 // while the option was never given. A row without them is a bug that
@@ -316,6 +326,7 @@ const OptionRow kOptions[] = {
     {"-preintegrated", [](Apply& a) { a.scene({{"sampling", {{"preintegrated", parseBoolean(a.option, a.value)}}}}); },
      "BOOLEAN", "off"},
     {"-earlyterm", [](Apply& a) { setScalar(a, "sampling", "early_termination", a.positive()); }, "A", "1 (off)"},
+    {"-quality", setQuality, "DB", "0 (off: every region at -step)"},
     {"-shading", [](Apply& a) { a.scene({{"shading", {{"enabled", parseBoolean(a.option, a.value)}}}}); }, "BOOLEAN",
      "on for 3-D data"},
     {"-ambient", [](Apply& a) { setScalar(a, "shading", "ambient", a.number()); }, "KA", "0.2"},

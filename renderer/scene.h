@@ -92,10 +92,18 @@ struct ImageSpec {
 // across the diagonal of a 240000-voxel-wide grid.
 inline constexpr double kMaxSamplesPerRay = 1 << 20;
 
+// The most a sampling.target_psnr may ask (dB): beyond what float
+// rendering resolves.
+inline constexpr double kMaxTargetPsnr = 120;
+
 struct SamplingSpec {
   double step = 0;              // world length; 0 = half the smallest spacing
   bool preintegrated = false;
   double earlyTermination = 1;  // a_max; 1 = off (rays run to the end)
+  // "target_psnr": > 0 lets the renderer pick the step of each region,
+  // from step / 8 to 8 step, to meet this PSNR in dB (raycast/step_levels.h);
+  // 0 = off, every region at `step`.
+  double targetPsnr = 0;
 };
 
 struct ShadingSpec {

@@ -36,7 +36,7 @@ json imageToJson(const ImageSpec& image) {
 
 SamplingSpec parseSampling(const json& v) {
   const std::string path = "sampling";
-  requireObject(v, path, {"step", "preintegrated", "early_termination"});
+  requireObject(v, path, {"step", "preintegrated", "early_termination", "target_psnr"});
   SamplingSpec s;
   if (const json* k = find(v, "step")) s.step = positive(*k, path + ".step");
   if (const json* k = find(v, "preintegrated")) s.preintegrated = asBool(*k, path + ".preintegrated");
@@ -45,6 +45,14 @@ SamplingSpec parseSampling(const json& v) {
     if (!(s.earlyTermination > 0 && s.earlyTermination <= 1))
       fail(path + ".early_termination", "must be in (0, 1], got " + numberText(s.earlyTermination));
   }
+  if (const json* k = find(v, "target_psnr")) {
+    s.targetPsnr = asNumber(*k, path + ".target_psnr");
+    if (!(s.targetPsnr >= 0 && s.targetPsnr <= kMaxTargetPsnr))
+      fail(path + ".target_psnr", "must be in [0, " + numberText(kMaxTargetPsnr) + "] dB (0 = off), got " +
+                                      numberText(s.targetPsnr));
+    if (s.targetPsnr > 0 && s.preintegrated)
+      fail(path + ".target_psnr", "chooses the step of plain sampling; it cannot be combined with preintegrated");
+  }
   return s;
 }
 
@@ -52,6 +60,7 @@ json samplingToJson(const SamplingSpec& sampling) {
   // Step 0 ("half a voxel") is the absent key.
   json out = {{"preintegrated", sampling.preintegrated}, {"early_termination", sampling.earlyTermination}};
   if (sampling.step > 0) out["step"] = sampling.step;
+  if (sampling.targetPsnr > 0) out["target_psnr"] = sampling.targetPsnr;
   return out;
 }
 

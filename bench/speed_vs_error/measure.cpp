@@ -187,7 +187,7 @@ Reference computeReference(const BenchScene& scene, const ReferenceSettings& set
 }
 
 Case ownCase(const core::Scene& scene) {
-  return {scene.sampling.step, scene.sampling.preintegrated, true};
+  return {scene.sampling.step, scene.sampling.preintegrated, true, scene.sampling.targetPsnr};
 }
 
 core::CameraSpec azimuth(const core::CameraSpec& camera, double degrees) {
@@ -271,6 +271,7 @@ CaseResult measureCase(const BenchScene& scene, const Case& c, const Reference& 
   options.step = c.step;
   options.preintegrated = c.preintegrated;
   options.skipEmpty = c.skipEmpty;
+  options.targetPsnr = c.targetPsnr;
   core::BrickRenderer renderer(scene.volume());
   renderer.classify(s.volumes.front().transfer, options);
 

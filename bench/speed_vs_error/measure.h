@@ -78,6 +78,7 @@ struct Case {
   double step = 0;  // world units
   bool preintegrated = false;
   bool skipEmpty = true;
+  double targetPsnr = 0;  // > 0: the step per region for this PSNR (sampling.target_psnr)
 };
 // The case the scene file itself asks for (its step, its pre-integration,
 // skipping on as in pvr-render).

@@ -25,9 +25,14 @@
 // Options: --threads N (2), --frames N (5), --error-size N (256: longer side of
 // the reference and of the images compared with it), --substeps N (64: the
 // reference's dt is the smallest spacing / N, at most the scene step / 16),
-// --steps LIST (voxels, comma-separated), --case-seconds S (sweep: stop timing
+// --steps LIST (voxels, comma-separated), --quality LIST (dB, comma-separated:
+// per scene and target, sampling.target_psnr at the scene's step, its
+// achieved PSNR and time beside the time of a uniform step of the same
+// error, interpolated from the sweep, which then runs plain sampling with
+// skipping only; quality.sh runs it on every scene), --case-seconds S (sweep: stop timing
 // a case once its frames add up to S seconds, after at least one; the CSV
 // says how many frames each median has), --csv PATH, --cache DIR, --no-cache.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -67,6 +72,7 @@ struct Args {
   std::string peerModel;  // --quick: the scene as that renderer models it (--peer-model)
   std::vector<std::string> scenes;
   std::vector<double> steps{2, 1, 0.5, 0.25, 0.125};
+  std::vector<double> quality;  // target PSNRs, dB
   int threads = 2, frames = 5, orbit = 0;
   double caseSeconds = 0;  // sweep: stop timing a case after this long (0 = never)
   bench::ReferenceSettings reference{256, 64, 16, PVR_BENCH_CACHE};
@@ -77,22 +83,22 @@ struct Args {
   std::fprintf(stderr,
                "speed_vs_error: %s\n"
                "usage: speed_vs_error [--threads N] [--frames N] [--error-size N] [--substeps N]\n"
-               "                      [--steps A,B,...] [--case-seconds S] [--csv PATH]\n"
+               "                      [--steps A,B,...] [--quality DB,DB,...] [--case-seconds S] [--csv PATH]\n"
                "                      [--cache DIR | --no-cache] [SCENE.json ...]\n"
                "       speed_vs_error --quick SCENE.json [--orbit K] [--peer-png FILE [--peer-model SCENE.json]] [same options]\n",
                why.c_str());
   std::exit(2);
 }
 
-std::vector<double> parseList(const std::string& text) {
+std::vector<double> parseList(const std::string& option, const std::string& text) {
   std::vector<double> out;
   std::stringstream in(text);
   for (std::string item; std::getline(in, item, ',');) {
     const double v = std::stod(item);
-    if (!(v > 0)) usage("--steps: every step must be > 0");
+    if (!(v > 0)) usage(option + ": every value must be > 0");
     out.push_back(v);
   }
-  if (out.empty()) usage("--steps: no steps");
+  if (out.empty()) usage(option + ": no values");
   return out;
 }
 
@@ -119,7 +125,8 @@ Args parseArgs(int argc, char** argv) {
       else if (arg == "--case-seconds") a.caseSeconds = std::stod(value());
       else if (arg == "--error-size") a.reference.maxEdge = positive(value());
       else if (arg == "--substeps") a.reference.substeps = positive(value());
-      else if (arg == "--steps") a.steps = parseList(value());
+      else if (arg == "--steps") a.steps = parseList(arg, value());
+      else if (arg == "--quality") a.quality = parseList(arg, value());
       else if (arg == "--csv") a.csv = value();
       else if (arg == "--cache") a.reference.cacheDir = value();
       else if (arg == "--no-cache") a.reference.cacheDir.clear();
@@ -222,16 +229,19 @@ std::vector<SweepCase> sweepCases(const Args& args, const BenchScene& scene) {
   const Case own = bench::ownCase(scene.scene());
   std::vector<SweepCase> cases;
   bool ownFound = false;
+  // With --quality, the uniform steps the targets are compared with only.
+  const std::vector<bool> pres = args.quality.empty() ? std::vector<bool>{false, true} : std::vector<bool>{false};
+  const std::vector<bool> skips = args.quality.empty() ? std::vector<bool>{true, false} : std::vector<bool>{true};
   for (double steps : args.steps)
-    for (bool pre : {false, true})
-      for (bool skip : {true, false}) {
+    for (bool pre : pres)
+      for (bool skip : skips) {
         const Case c{steps * scene.voxel(), pre, skip};
         const bool isOwn = std::abs(c.step - own.step) <= 1e-6 * own.step &&
                            pre == own.preintegrated && skip == own.skipEmpty;
         ownFound |= isOwn;
         cases.push_back({c, isOwn});
       }
-  if (!ownFound) cases.push_back({own, true});
+  if (!ownFound && args.quality.empty()) cases.push_back({own, true});
   return cases;
 }
 
@@ -250,7 +260,7 @@ class CsvWriter {
     out_ << "scene,volume,shaded,step_voxels,step_world,preintegrated,skipping,scene_default,"
             "threads,width,height,frames,median_s,min_s,max_s,samples_per_frame,msamples_per_s,"
             "msamples_per_s_per_core,error_width,error_height,rmse,psnr_db,max_abs,"
-            "reference_dt_voxels,load1\n";
+            "reference_dt_voxels,load1,target_psnr_db\n";
   }
   void row(const BenchScene& scene, const SweepCase& sc, const CaseResult& r, const Reference& ref,
            int threads) {
@@ -259,7 +269,7 @@ class CsvWriter {
     char line[1024];
     std::snprintf(line, sizeof line,
                   "%s,%s,%d,%.6g,%.6g,%d,%d,%d,%d,%d,%d,%d,%.6f,%.6f,%.6f,%.0f,%.3f,%.3f,%d,%d,"
-                  "%.6e,%.3f,%.6e,%.6g,%.2f\n",
+                  "%.6e,%.3f,%.6e,%.6g,%.2f,%.6g\n",
                   csvField(shortName(scene.path())).c_str(), csvField(scene.describe()).c_str(),
                   int(s.shading.enabled), sc.c.step / scene.voxel(), sc.c.step,
                   int(sc.c.preintegrated), int(sc.c.skipEmpty),
@@ -267,7 +277,7 @@ class CsvWriter {
                   t.max, t.frames > 0 ? double(t.samples) / t.frames : 0.0,
                   t.samplesPerSecond() * 1e-6, t.samplesPerSecond() * 1e-6 / threads,
                   ref.size.width, ref.size.height, r.error.rmse, r.error.psnr, r.error.maxAbs,
-                  ref.dt / scene.voxel(), r.load1);
+                  ref.dt / scene.voxel(), r.load1, sc.c.targetPsnr);
     out_ << line;
     out_.flush();
   }
@@ -316,6 +326,63 @@ void printPreintegration(const std::vector<SweepRow>& rows, const bench::Rebuild
   }
 }
 
+// What a uniform step (plain, skipping on) whose error is `psnr` costs,
+// interpolated from the sweep's rows: log time and log samples per frame
+// linear in PSNR between the two rows around it; zeros when the sweep does
+// not reach that PSNR.
+struct UniformCost {
+  double seconds = 0, samples = 0;
+};
+UniformCost uniformCostAt(const std::vector<SweepRow>& rows, double psnr) {
+  struct Point {
+    double psnr, seconds, samples;
+  };
+  std::vector<Point> curve;
+  for (const SweepRow& row : rows)
+    if (row.sc.c.targetPsnr == 0 && !row.sc.c.preintegrated && row.sc.c.skipEmpty && row.r.timing.frames > 0)
+      curve.push_back({row.r.error.psnr, row.r.timing.median, double(row.r.timing.samples) / row.r.timing.frames});
+  std::sort(curve.begin(), curve.end(), [](const Point& a, const Point& b) { return a.psnr < b.psnr; });
+  for (std::size_t i = 0; i + 1 < curve.size(); ++i) {
+    const Point& a = curve[i];
+    const Point& b = curve[i + 1];
+    if (psnr < a.psnr || psnr > b.psnr || !(b.psnr > a.psnr)) continue;
+    const double w = (psnr - a.psnr) / (b.psnr - a.psnr);
+    auto mix = [w](double x, double y) { return std::exp(std::log(x) + w * (std::log(y) - std::log(x))); };
+    return {mix(a.seconds, b.seconds), mix(a.samples, b.samples)};
+  }
+  return {};
+}
+
+// Quality chosen by error: each target at the scene's step, its achieved
+// error, time and samples, and what a uniform step of that error costs
+// (time and samples, and the target's cost over it: "x" < 1 is cheaper).
+void runQuality(const Args& args, const BenchScene& scene, const Reference& ref, std::vector<SweepRow>& rows,
+                CsvWriter& csv, core::ThreadPool& pool) {
+  std::printf("  quality chosen by error (sampling.target_psnr at step %.3g voxel, plain, skipping on):\n",
+              scene.scene().sampling.step / scene.voxel());
+  std::printf("  %-9s %9s %-4s %9s %12s %9s %12s %8s %8s %5s\n", "target dB", "PSNR dB", "met", "s/frame",
+              "samples", "uniform s", "uniform samp", "time x", "samp x", "load");
+  for (double target : args.quality) {
+    const SweepCase sc{{scene.scene().sampling.step, false, true, target}, false};
+    const CaseResult r = bench::measureCase(scene, sc.c, ref, args.frames, args.caseSeconds, 0, pool);
+    const UniformCost uniform = uniformCostAt(rows, r.error.psnr);
+    const double samples = r.timing.frames > 0 ? double(r.timing.samples) / r.timing.frames : 0.0;
+    char text[4][32] = {"-", "-", "-", "-"};
+    if (uniform.seconds > 0) {
+      std::snprintf(text[0], sizeof text[0], "%.4f", uniform.seconds);
+      std::snprintf(text[1], sizeof text[1], "%.0f", uniform.samples);
+      std::snprintf(text[2], sizeof text[2], "%.2f", r.timing.median / uniform.seconds);
+      std::snprintf(text[3], sizeof text[3], "%.2f", samples / uniform.samples);
+    }
+    std::printf("  %-9.4g %9.2f %-4s %9.4f %12.0f %9s %12s %8s %8s %5.2f\n", target, r.error.psnr,
+                r.error.psnr >= target ? "yes" : "NO", r.timing.median, samples, text[0], text[1], text[2],
+                text[3], r.load1);
+    std::fflush(stdout);
+    csv.row(scene, sc, r, ref, pool.size());
+    rows.push_back({sc, r});
+  }
+}
+
 int runSweep(const Args& args) {
   core::ThreadPool pool(args.threads);
   fs::create_directories(fs::path(args.csv).parent_path());
@@ -348,7 +415,8 @@ int runSweep(const Args& args) {
       csv.row(scene, sc, r, ref, pool.size());
       rows.push_back({sc, r});
     }
-    printPreintegration(rows, bench::rebuildTimes(scene, 9, pool), scene.voxel());
+    if (args.quality.empty()) printPreintegration(rows, bench::rebuildTimes(scene, 9, pool), scene.voxel());
+    else runQuality(args, scene, ref, rows, csv, pool);
   }
   std::printf("\nwrote %s\n", args.csv.c_str());
   return 0;

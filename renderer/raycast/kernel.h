@@ -53,6 +53,12 @@ struct KernelParams {
   // Shading (world space).
   float ambient = 0, diffuse = 0, specular = 0, shininess = 1;
   const float* specularTable = nullptr;  // kSpecularTableSize values of x^shininess, x in [0, 1]
+  // Quality chosen by error (step_levels.h, cast_ray_levels.h): the level
+  // of each macrocell of StepLevels' layout, and per level l these
+  // parameters with the table of a step of 2^l fine steps.
+  const std::uint8_t* levels = nullptr;
+  int lvFirst[3] = {0, 0, 0}, lvCount[3] = {0, 0, 0}, lvDomainLast[3] = {0, 0, 0};
+  const KernelParams* atLevel = nullptr;
 };
 
 // One ray in the brick's index space: u(k) = origin + k * step.

@@ -66,6 +66,20 @@ void setTables(KernelParams& p, const TransferTable& table, const PreintegratedT
   p.stepLength = step;
 }
 
+void setLevels(KernelParams& p, const StepLevels& levels, const std::vector<TransferTable>& tables,
+               double fineStep, std::vector<KernelParams>& atLevel) {
+  p.levels = levels.levels();
+  for (int a = 0; a < 3; ++a) {
+    p.lvFirst[a] = int(levels.first()[a]);
+    p.lvCount[a] = int(levels.count()[a]);
+    p.lvDomainLast[a] = int(levels.domainCount()[a] - 1);
+  }
+  atLevel.assign(tables.size(), p);
+  for (std::size_t l = 0; l < tables.size(); ++l)
+    setTables(atLevel[l], tables[l], nullptr, fineStep * double(std::int64_t(1) << l));
+  p.atLevel = atLevel.data();
+}
+
 void setOptions(KernelParams& p, const RenderOptions& options, const float* specularTable) {
   p.earlyTermination = float(std::clamp(options.earlyTermination, 0.0, 1.0));
   p.ambient = float(options.shading.ambient);

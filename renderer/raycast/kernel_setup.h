@@ -12,6 +12,7 @@
 #include "kernel.h"
 #include "macrocells.h"
 #include "raycaster.h"
+#include "step_levels.h"
 
 namespace pvr::core {
 
@@ -29,6 +30,13 @@ void ownRegion(KernelParams& p, const GridGeometry& grid, const WorldRegion& reg
 // Both tables must outlive p.
 void setTables(KernelParams& p, const TransferTable& table, const PreintegratedTable* preintegrated,
                double step);
+
+// Quality chosen by error: `levels`' field in p (filled but for it), and
+// in `atLevel` a copy of p per level with that level's table and step
+// (tables[l], 2^l fineStep); p.atLevel points to it. The tables and
+// atLevel must outlive p.
+void setLevels(KernelParams& p, const StepLevels& levels, const std::vector<TransferTable>& tables,
+               double fineStep, std::vector<KernelParams>& atLevel);
 
 // Early termination and shading parameters of `options`. `specularTable`
 // (specularTable() of the same shininess) must outlive p.

@@ -8,6 +8,7 @@
 
 #include "../error.h"
 #include "cast_ray.h"
+#include "cast_ray_levels.h"
 #include "kernel_setup.h"
 #include "tiles.h"
 
@@ -31,6 +32,17 @@ RayFunction pickKernel(ScalarType type, bool shaded, bool preintegrated) {
   });
 }
 
+// The kernel that picks the step per region (plain sampling only).
+RayFunction pickLevelKernel(ScalarType type, bool shaded) {
+  return dispatchScalar(type, [&](auto tag) -> RayFunction {
+    using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+    return shaded ? &castRayByLevels<T, true> : &castRayByLevels<T, false>;
+  });
+}
+
+// Quality chosen by error applies to these options (RenderOptions::targetPsnr).
+bool byLevels(const RenderOptions& options) { return options.targetPsnr > 0 && !options.preintegrated; }
+
 }  // namespace
 
 RenderOptions renderOptionsFor(const Scene& scene) {
@@ -38,6 +50,7 @@ RenderOptions renderOptionsFor(const Scene& scene) {
   o.step = scene.sampling.step;
   o.earlyTermination = scene.sampling.earlyTermination;
   o.preintegrated = scene.sampling.preintegrated;
+  o.targetPsnr = scene.sampling.targetPsnr;
   o.shading = scene.shading;
   return o;
 }
@@ -54,13 +67,23 @@ int ghostLayers(const GridGeometry& grid, const RenderOptions& options) {
     // above from a step of one voxel on).
     if (options.shading.enabled) layers = std::max(layers, int(std::ceil(steps - 1e-9)) + 1);
   }
+  if (byLevels(options)) layers = std::max(layers, levelGhostLayers(grid, options.step));
   return layers;
 }
 
 BrickRenderer::BrickRenderer(const Brick& brick, ThreadPool* pool) : brick_(brick), macrocells_(brick, pool) {}
 
 void BrickRenderer::classify(const TransferFunctionSpec& tf, const RenderOptions& options, ThreadPool* pool) {
-  table_ = TransferTable(tf, options.step);
+  levelTables_.clear();
+  // A brick of a several-volume scene keeps the scene's step (raycaster.h).
+  if (byLevels(options) && !region_) {
+    if (!levels_ || levels_->sceneStep() != options.step)
+      levels_ = std::make_unique<StepLevels>(brick_, options.step, pool);
+    levels_->choose(tf, options.targetPsnr,
+                    options.shading.enabled ? options.shading.diffuse + options.shading.specular : 0.0);
+    for (int l = 0; l < kStepLevels; ++l) levelTables_.emplace_back(tf, fineStep(options.step) * double(1 << l));
+  }
+  table_ = levelTables_.empty() ? TransferTable(tf, options.step) : levelTables_.front();
   preintegrated_.reset();
   if (options.preintegrated) preintegrated_ = std::make_unique<PreintegratedTable>(tf);
   macrocells_.classify(table_, options.skipEmpty, pool);
@@ -100,16 +123,21 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   KernelParams p;
   setBrick(p, brick_, macrocells_);
   if (region_) ownRegion(p, grid, *region_);
-  setTables(p, table_, preintegrated_.get(), options.step);
+  const bool levelled = !levelTables_.empty();
+  const double step = levelled ? fineStep(options.step) : options.step;  // the rays' sample spacing
+  setTables(p, table_, preintegrated_.get(), step);
   const std::vector<float> specular = specularTable(options.shading.shininess);
   setOptions(p, options, specular.data());
-  const RayFunction cast = pickKernel(brick_.type(), options.shading.enabled, bool(preintegrated_));
+  std::vector<KernelParams> atLevel;
+  if (levelled) setLevels(p, *levels_, levelTables_, step, atLevel);
+  const RayFunction cast = levelled ? pickLevelKernel(brick_.type(), options.shading.enabled)
+                                    : pickKernel(brick_.type(), options.shading.enabled, bool(preintegrated_));
   const Vec3 lightWorld = normalize(camera.toWorld(options.shading.lightDirection));
 
   // Tiles of the rectangle over the pool; each worker counts its own work.
   RenderStats counted;
   renderTiles(image, options, pool, [&](int x, int y) {
-    const RaySetup s = raySetup(camera.ray(x, y), grid, options.step, lightWorld);
+    const RaySetup s = raySetup(camera.ray(x, y), grid, step, lightWorld);
     return cast(p, s, MacrocellGrid::kShift);
   }, counted);
   if (stats) {

@@ -23,6 +23,7 @@
 #include "../thread_pool.h"
 #include "../transfer.h"
 #include "macrocells.h"
+#include "step_levels.h"
 
 namespace pvr::core {
 
@@ -30,6 +31,10 @@ struct RenderOptions {
   double step = 0;              // world length h, > 0
   double earlyTermination = 1;  // stop a ray once its opacity reaches this; 1 = off
   bool preintegrated = false;
+  // > 0: the step of each region is chosen to meet this PSNR (dB), between
+  // step / 8 and 8 step (step_levels.h). Plain sampling of a scene of one
+  // volume only: pre-integration and several volumes keep `step`.
+  double targetPsnr = 0;
   bool skipEmpty = true;        // macrocell empty-space skipping
   ShadingSpec shading;
   // Checked between tiles, never per sample: once it reads true, tiles not
@@ -47,7 +52,8 @@ RenderOptions renderOptionsFor(const Scene& resolvedScene);
 // trilinear sampling needs none (neighbours share the face nodes), central
 // differences one, a pre-integrated segment reads two steps beyond (its
 // back node's curvature correction) and is lit up to a step beyond, one
-// more for its central differences.
+// more for its central differences; a target PSNR reads the value ranges
+// of macrocells a level block's length beyond (levelGhostLayers()).
 int ghostLayers(const GridGeometry& grid, const RenderOptions& options);
 
 struct RenderStats {
@@ -94,6 +100,10 @@ class BrickRenderer {
   MacrocellGrid macrocells_;
   TransferTable table_;
   std::unique_ptr<PreintegratedTable> preintegrated_;
+  // Quality chosen by error: the macrocells' levels (kept while the step
+  // stays) and one table per level; empty tables when it is off.
+  std::unique_ptr<StepLevels> levels_;
+  std::vector<TransferTable> levelTables_;
   double classifiedStep_ = 0;
   std::optional<WorldRegion> region_;
 };

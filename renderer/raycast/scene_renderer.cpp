@@ -59,6 +59,9 @@ void SceneRenderer::classify(const std::vector<SceneVolume>& volumes, const Rend
   // the macrocells (pre-integration does not mix) and extinction tables.
   RenderOptions own = options;
   if (shown_.size() > 1) own.preintegrated = false;
+  // The step per region is for one volume alone; a scene of several keeps
+  // its step in every brick, visible or not (raycaster.h, targetPsnr).
+  if (volumes.size() > 1) own.targetPsnr = 0;
   for (int i : shown_) {
     Layer& layer = layers_[i];
     if (!layer.brick) continue;

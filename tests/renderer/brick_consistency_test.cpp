@@ -25,9 +25,11 @@
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
+#include <set>
 #include <vector>
 
 #include "raycast/raycaster.h"
+#include "raycast/step_levels.h"
 #include "reference.h"
 
 namespace pvr::core {
@@ -287,6 +289,29 @@ TEST_CASE("bricks equal the whole: anisotropic spacing", "[bricks]") {
   const Camera camera = orthographic(grid, {0.4, 0.6, -0.7}, {0, 0, 1}, 96);
   checkSplitsMatch(volume, tf, camera, makeOptions(0.8), {3, 7});
   checkSplitsMatch(volume, tf, camera, makeOptions(1.5, true, true), {4, 9});
+}
+
+
+// Quality chosen by error (step_levels.h): every brick reads a block's
+// level at the same points of the global level field and owns the coarse
+// samples whose positions it owns, so bricks still equal the whole while
+// the step changes from region to region.
+TEST_CASE("bricks equal the whole: step chosen per region by a target PSNR", "[bricks]") {
+  const GridGeometry grid = cubeGrid(40);
+  const Brick volume = signalVolume(grid, ScalarType::kFloat32, 0, 1);
+  const TransferFunctionSpec tf = signalTransfer(0, 1, 1.0);
+  // The scene must take several steps for the check to mean anything.
+  StepLevels levels(volume, 0.5);
+  levels.choose(tf, 45, 0);
+  const std::set<int> taken(levels.levels(), levels.levels() + levels.count().product());
+  REQUIRE(taken.size() >= 3);
+  for (bool shaded : {false, true}) {
+    RenderOptions o = makeOptions(0.5, false, shaded);
+    o.targetPsnr = 45;
+    INFO((shaded ? "shaded" : "unshaded"));
+    checkSplitsMatch(volume, tf, orthographic(grid, normalize(Vec3{0.3, -0.5, 0.8}), {0, 0, 1}, 48), o, {2, 5});
+    checkSplitsMatch(volume, tf, perspective({-30, -45, 50}, {20, 18, 21}, {0, 0, 1}, 40, 48), o, {3, 8});
+  }
 }
 
 }  // namespace pvr::core

@@ -13,6 +13,7 @@
 
 #include "camera.h"
 #include "error.h"
+#include "raycast/raycaster.h"
 #include "scene.h"
 #include "test_files.h"
 
@@ -194,7 +195,7 @@ TEST_CASE("unknown keys are errors naming the key path and the known keys", "[sc
       {"/volume/dim", "volume.dim: unknown key (known: file, procedural, computation, dims, spacing)"},
       {"/transfer_function/point", "transfer_function.point: unknown key (known: points, paraview_preset, paraview, unit_distance, absolute)"},
       {"/image/size", "image.size: unknown key (known: width, height, background)"},
-      {"/sampling/steps", "sampling.steps: unknown key (known: step, preintegrated, early_termination)"},
+      {"/sampling/steps", "sampling.steps: unknown key (known: step, preintegrated, early_termination, target_psnr)"},
       {"/shading/light", "shading.light: unknown key (known: enabled, ambient, diffuse, specular, shininess, light_direction)"},
   };
   for (const Case& c : cases) {
@@ -222,6 +223,9 @@ TEST_CASE("wrong types and bad values are errors naming the key path", "[scene]"
       {"/sampling/early_termination", 0, "sampling.early_termination: must be in (0, 1], got 0"},
       {"/sampling/early_termination", 1.5, "sampling.early_termination: must be in (0, 1], got 1.5"},
       {"/sampling/preintegrated", 1, "sampling.preintegrated: must be true or false, got number 1"},
+      {"/sampling/target_psnr", -1, "sampling.target_psnr: must be in [0, 120] dB (0 = off), got -1"},
+      {"/sampling/target_psnr", 121, "sampling.target_psnr: must be in [0, 120] dB (0 = off), got 121"},
+      {"/sampling/target_psnr", "high", "sampling.target_psnr: must be a number"},
       {"/transfer_function/points/1/4", 1.5, "transfer_function.points[1][4]: must be in [0, 1], got 1.5"},
       {"/transfer_function/points/1/4", -0.1, "transfer_function.points[1][4]: must be in [0, 1], got -0.1"},
       {"/transfer_function/points/0/1", -0.1, "transfer_function.points[0][1]: must be >= 0, got -0.1"},
@@ -567,4 +571,18 @@ TEST_CASE("shading left to the data is on for 3-D volumes, off for a slice, as s
   Scene off = parseScene(json::parse(R"({"volume": {"file": "ct.nhdr"}, "shading": {"enabled": false}})"), "");
   resolveDefaults(off, volume);
   CHECK_FALSE(off.shading.enabled);
+}
+
+// sampling.target_psnr: read, printed back, and refused beside pre-integration.
+TEST_CASE("sampling.target_psnr is read, printed and not combined with preintegrated", "[scene]") {
+  json doc = baseDoc();
+  doc["sampling"]["target_psnr"] = 50;
+  const Scene s = parseScene(doc, "");
+  CHECK(s.sampling.targetPsnr == 50);
+  CHECK(sceneToJson(s)["sampling"]["target_psnr"] == 50);
+  CHECK(renderOptionsFor(s).targetPsnr == 50);
+  CHECK_FALSE(sceneToJson(parseScene(baseDoc(), ""))["sampling"].contains("target_psnr"));
+  doc["sampling"]["preintegrated"] = true;
+  CHECK(parseError(doc).rfind("sampling.target_psnr: chooses the step of plain sampling; it cannot be combined "
+                              "with preintegrated", 0) == 0);
 }
