@@ -617,9 +617,9 @@ int Session::run() {
       done_ = true;
       break;
     }
-    // A client waiting for its allocation, or for frames it asked for, is
-    // not idle.
-    if (queued_ || !rendering_.empty()) lastFrame = now;
+    // A client waiting for its allocation, for its job to start, or for
+    // frames it asked for, is not idle.
+    if (queued_ || openRequest_ != 0 || !rendering_.empty()) lastFrame = now;
     if (now - lastFrame > opt_.idleTimeout) {
       endConnection(ErrorCode::kTimeout, "idle for " + std::to_string(int(opt_.idleTimeout)) + " s", 0);
       break;
