@@ -50,7 +50,7 @@ steps=${PVR_SCALE_STEPS:-50}
 cachemem=${PVR_SCALE_CACHEMEM:-4096}
 tag=${PVR_SCALE_TAG:-scale}
 out=$root/bench/results/scale
-head_json=$(cd "$root/../shared/data/ct_head_cranium" && pwd)/ct_head_cranium.json
+head_json=$root/../shared/data/ct_head_cranium/ct_head_cranium.json  # read only when a volume is written
 node=$build/pvrd/pvr-node pvrd=$build/pvrd/pvrd pvrsh=$build/pvrsh/pvrsh gen=$build/bench/scale/pvr-bench-scale-volume
 for exe in "$node" "$pvrd" "$pvrsh" "$gen"; do
   [ -x "$exe" ] || { echo "run.sh: build $exe first (cmake --build $build --target pvr-node pvrd pvrsh pvr-bench-scale-volume)" >&2; exit 1; }
