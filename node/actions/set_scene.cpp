@@ -27,7 +27,10 @@ void SetScene::run(NodeState& state, const SetScene& args) {
     state.matchPoolToSettings();
     state.cache.setBudget(cacheBudgetBytes(state.settings));
     for (auto& [key, served] : state.served) served.cache->setBudget(cacheBudgetBytes(state.settings) / state.served.size());
-    classify(state);
+    // Bricks about to be read again are classified once they are (loadBricks):
+    // classified now, with options asking for more ghost layers than they
+    // hold (a quality target's step levels), they would fail.
+    if (reload != Reload::kAll) classify(state);
   });
   if (reload == Reload::kAll) loadBricks(state);
   else if (reload == Reload::kStep) loadStep(state);

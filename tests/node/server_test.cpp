@@ -1188,6 +1188,22 @@ TEST_CASE_METHOD(Fixture, "new ghost layers are read with a compositing cluster 
   CHECK(job.close());
 }
 
+TEST_CASE_METHOD(Fixture, "a quality target set on an open session reads the ghost layers its step levels need") {
+  Job job(2);
+  job.send(proto::SessionOpen{2, {}, ""});
+  job.expect<proto::SessionReady>();
+  job.send(proto::SetScene{"phantom.json", kScene});
+  job.expect<proto::Ok>();
+  auto id = job.send(proto::RenderFrame{});
+  checkSequence(job, id, 1, 1, Reference(nlohmann::json::object()));
+  const char* quality = R"({"sampling": {"target_psnr": 45}})";
+  job.send(proto::SetScene{"", quality});
+  job.expect<proto::Ok>();
+  id = job.send(proto::RenderFrame{});
+  checkSequence(job, id, 1, 1, Reference(nlohmann::json::parse(quality)));
+  CHECK(job.close());
+}
+
 // ---- Steering: a computation volume (docs/steering.md) ----
 
 namespace {
