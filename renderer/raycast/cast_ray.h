@@ -144,6 +144,22 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
   return false;
 }
 
+// Where the ray goes on from sample k: k itself when k's macrocell is
+// visible; else past the empty space. Deep in it, past the macrocells the
+// distance field proves empty (those within d - 1 of this one, wherever
+// sample k lies inside it); next to something visible, out of this
+// macrocell. o and d: the ray's origin and step in float, as the samples'.
+[[gnu::always_inline]] inline std::int64_t pastEmpty(const KernelParams& p, const RaySetup& ray, const float* o,
+                                                     const float* d, std::int64_t k, int mcShift) {
+  int m[3];
+  for (int a = 0; a < 3; ++a)
+    m[a] = std::clamp(int(o[a] + float(k) * d[a]) >> mcShift, p.mcFirst[a], p.mcFirst[a] + p.mcCount[a] - 1);
+  const int distance = p.distance[macrocellIndex(p, m)];
+  if (distance == 0) return k;
+  return distance > 1 ? k + std::max<std::int64_t>(1, std::int64_t(double(distance - 1) * ray.leapPerMacrocell))
+                      : macrocellExit(ray, m, k, mcShift);
+}
+
 }  // namespace kernel
 
 template <typename T, bool kShaded, bool kPreintegrated>
@@ -170,27 +186,15 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
   out.hit = true;
   const kernel::ChordEnds ends = kernel::chordEnds(p, ray, first, last);
 
-  const float o0 = float(ray.origin[0]), o1 = float(ray.origin[1]), o2 = float(ray.origin[2]);
-  const float d0 = float(ray.step[0]), d1 = float(ray.step[1]), d2 = float(ray.step[2]);
+  const float o[3] = {float(ray.origin[0]), float(ray.origin[1]), float(ray.origin[2])};
+  const float d[3] = {float(ray.step[0]), float(ray.step[1]), float(ray.step[2])};
   kernel::Accumulator acc;
   std::int64_t done = first;  // next sample not yet composited or skipped
   const std::int64_t chunk = kernel::visibleChunk(ray);
   std::int64_t k = first;
   while (k <= last) {
-    // Which macrocell holds sample k?
-    const float u0 = o0 + float(k) * d0, u1 = o1 + float(k) * d1, u2 = o2 + float(k) * d2;
-    const int m[3] = {std::clamp(int(u0) >> mcShift, p.mcFirst[0], p.mcFirst[0] + p.mcCount[0] - 1),
-                      std::clamp(int(u1) >> mcShift, p.mcFirst[1], p.mcFirst[1] + p.mcCount[1] - 1),
-                      std::clamp(int(u2) >> mcShift, p.mcFirst[2], p.mcFirst[2] + p.mcCount[2] - 1)};
-    const std::size_t cell = kernel::macrocellIndex(p, m);
-    const int distance = p.distance[cell];
-    if (distance != 0) {
-      // Empty space. Deep in it, leap over the macrocells the distance
-      // field proves empty (those within d - 1 of this one, wherever sample
-      // k lies inside it); next to something visible, step out of this
-      // macrocell.
-      k = distance > 1 ? k + std::max<std::int64_t>(1, std::int64_t(double(distance - 1) * ray.leapPerMacrocell))
-                       : kernel::macrocellExit(ray, m, k, mcShift);
+    if (const std::int64_t next = kernel::pastEmpty(p, ray, o, d, k, mcShift); next != k) {
+      k = next;
       continue;
     }
     // Something visible: sample a fixed chunk and look again. Samples that

@@ -86,21 +86,15 @@ RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShif
   RaySetup coarse[kStepLevels];
   bool coarseSet[kStepLevels] = {};
 
-  const float o0 = float(ray.origin[0]), o1 = float(ray.origin[1]), o2 = float(ray.origin[2]);
-  const float d0 = float(ray.step[0]), d1 = float(ray.step[1]), d2 = float(ray.step[2]);
+  const float o[3] = {float(ray.origin[0]), float(ray.origin[1]), float(ray.origin[2])};
+  const float d[3] = {float(ray.step[0]), float(ray.step[1]), float(ray.step[2])};
   kernel::Accumulator acc;
   std::int64_t k = first;  // the next fine sample not yet covered or skipped
   while (k <= last) {
     // Empty space is skipped as castRay skips it: a coarse sample in
     // skipped space is transparent too.
-    const float u0 = o0 + float(k) * d0, u1 = o1 + float(k) * d1, u2 = o2 + float(k) * d2;
-    const int m[3] = {std::clamp(int(u0) >> mcShift, p.mcFirst[0], p.mcFirst[0] + p.mcCount[0] - 1),
-                      std::clamp(int(u1) >> mcShift, p.mcFirst[1], p.mcFirst[1] + p.mcCount[1] - 1),
-                      std::clamp(int(u2) >> mcShift, p.mcFirst[2], p.mcFirst[2] + p.mcCount[2] - 1)};
-    const int distance = p.distance[kernel::macrocellIndex(p, m)];
-    if (distance != 0) {
-      k = distance > 1 ? k + std::max<std::int64_t>(1, std::int64_t(double(distance - 1) * ray.leapPerMacrocell))
-                       : kernel::macrocellExit(ray, m, k, mcShift);
+    if (const std::int64_t next = kernel::pastEmpty(p, ray, o, d, k, mcShift); next != k) {
+      k = next;
       continue;
     }
     const std::int64_t block = k >> kLevelBlockShift, blockEnd = (block + 1) << kLevelBlockShift;
