@@ -145,10 +145,9 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
 }
 
 // Where the ray goes on from sample k: k itself when k's macrocell is
-// visible; else past the empty space. Deep in it, past the macrocells the
-// distance field proves empty (those within d - 1 of this one, wherever
-// sample k lies inside it); next to something visible, out of this
-// macrocell. o and d: the ray's origin and step in float, as the samples'.
+// visible; else past the empty cube around it that the distance field
+// proves (emptyExit). o and d: the ray's origin and step in float, as the
+// samples'.
 [[gnu::always_inline]] inline std::int64_t pastEmpty(const KernelParams& p, const RaySetup& ray, const float* o,
                                                      const float* d, std::int64_t k, int mcShift) {
   int m[3];
@@ -156,8 +155,7 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
     m[a] = std::clamp(int(o[a] + float(k) * d[a]) >> mcShift, p.mcFirst[a], p.mcFirst[a] + p.mcCount[a] - 1);
   const int distance = p.distance[macrocellIndex(p, m)];
   if (distance == 0) return k;
-  return distance > 1 ? k + std::max<std::int64_t>(1, std::int64_t(double(distance - 1) * ray.leapPerMacrocell))
-                      : macrocellExit(ray, m, k, mcShift);
+  return emptyExit(ray, m, distance, k, mcShift);
 }
 
 }  // namespace kernel
@@ -184,6 +182,10 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
     return out;
   }
   out.hit = true;
+  // The walk starts and ends at the visible box; a ray that misses it
+  // costs nothing more.
+  std::int64_t k = first, end = last;
+  if (!kernel::clipToVisible(p, ray, k, end)) return out;
   const kernel::ChordEnds ends = kernel::chordEnds(p, ray, first, last);
 
   const float o[3] = {float(ray.origin[0]), float(ray.origin[1]), float(ray.origin[2])};
@@ -191,8 +193,7 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
   kernel::Accumulator acc;
   std::int64_t done = first;  // next sample not yet composited or skipped
   const std::int64_t chunk = kernel::visibleChunk(ray);
-  std::int64_t k = first;
-  while (k <= last) {
+  while (k <= end) {
     if (const std::int64_t next = kernel::pastEmpty(p, ray, o, d, k, mcShift); next != k) {
       k = next;
       continue;

@@ -39,6 +39,11 @@ struct KernelParams {
   // Macrocells.
   const std::uint8_t* distance = nullptr;  // MacrocellGrid::distance(): 0 = visible
   int mcFirst[3], mcCount[3];
+  // Every sample whose macrocell is visible lies in this box, index units
+  // (the visible macrocells' box, MacrocellGrid::visibleFirst(), widened
+  // against rounding; open where it reaches the brick's outer macrocells,
+  // into which look-ups clamp); lo > hi when nothing is visible.
+  double visibleLo[3] = {-1e30, -1e30, -1e30}, visibleHi[3] = {1e30, 1e30, 1e30};
   // Classification.
   const Rgba* table = nullptr;  // TransferTable entries (plain)
   int tableEntries = 0;
@@ -339,6 +344,29 @@ inline bool sampleRange(const KernelParams& p, const RaySetup& r, std::int64_t& 
   return true;
 }
 
+// The samples [first, last] narrowed to those in the visible box
+// (KernelParams::visibleLo): the others lie in invisible macrocells, which
+// the ray would only walk past. False if none is left.
+inline bool clipToVisible(const KernelParams& p, const RaySetup& r, std::int64_t& first, std::int64_t& last) {
+  double kmin = double(first), kmax = double(last);
+  for (int a = 0; a < 3; ++a) {
+    if (!(p.visibleLo[a] <= p.visibleHi[a])) return false;
+    if (r.step[a] == 0) {
+      if (r.origin[a] < p.visibleLo[a] || r.origin[a] > p.visibleHi[a]) return false;
+      continue;
+    }
+    double k0 = (p.visibleLo[a] - r.origin[a]) * r.invStep[a];
+    double k1 = (p.visibleHi[a] - r.origin[a]) * r.invStep[a];
+    if (k0 > k1) std::swap(k0, k1);
+    kmin = std::max(kmin, k0);
+    kmax = std::min(kmax, k1);
+  }
+  if (!(kmin <= kmax)) return false;
+  first = std::max(first, std::int64_t(std::floor(kmin)));
+  last = std::min(last, std::int64_t(std::ceil(kmax)));
+  return first <= last;
+}
+
 // Where the ray's chord through the whole domain begins and ends, measured
 // against its samples. Each sample stands for a segment one step long (the
 // plain kernel: centred on the sample; pre-integration: from the sample to
@@ -437,15 +465,23 @@ inline std::size_t macrocellIndex(const KernelParams& p, const int* m) {
 inline constexpr std::int64_t kVisibleChunk = 16;
 inline std::int64_t visibleChunk(const RaySetup& r) { return r.leapPerMacrocell >= 8 ? 2 * kVisibleChunk : kVisibleChunk; }
 
-// The first sample at or after the ray leaves macrocell m (global index),
-// never less than k + 1.
-inline std::int64_t macrocellExit(const RaySetup& r, const int m[3], std::int64_t k, int shift) {
+// The first sample at or after the ray leaves the cube of macrocells
+// within `distance - 1` of macrocell m (global index), never less than
+// k + 1: where a macrocell's distance field value (MacrocellGrid::
+// distance()) proves that cube empty, a ray in m crosses it without a
+// look-up. Distance 1 is m itself. From anywhere in m the cube reaches at
+// least distance - 1 macrocells further along every axis, so this leaps at
+// least as far as distance - 1 macrocells along the major axis would, and
+// the rest of m and the cube's reach along the minor axes besides, with no
+// branch on the distance.
+inline std::int64_t emptyExit(const RaySetup& r, const int m[3], int distance, std::int64_t k, int shift) {
   double exitK = 1e300;
   for (int a = 0; a < 3; ++a) {
     if (r.step[a] > 0)
-      exitK = std::min(exitK, (double(std::int64_t(m[a] + 1) << shift) - r.origin[a]) * r.invStep[a]);
+      exitK = std::min(exitK, (double(std::int64_t(m[a] + distance) << shift) - r.origin[a]) * r.invStep[a]);
     else if (r.step[a] < 0)
-      exitK = std::min(exitK, (double(std::int64_t(m[a]) << shift) - r.origin[a]) * r.invStep[a]);
+      exitK = std::min(exitK, (double(std::int64_t(m[a] - distance + 1) * (std::int64_t(1) << shift)) - r.origin[a]) *
+                                  r.invStep[a]);
   }
   return std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(std::min(exitK, 1e18))));
 }

@@ -28,6 +28,18 @@ void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocel
     p.invSpacing[a] = float(1.0 / grid.spacing[a]);
     p.mcFirst[a] = int(macrocells.first()[a]);
     p.mcCount[a] = int(macrocells.count()[a]);
+    // A float position's rounding error stays far below the voxel the box
+    // is widened by for any position within 2^20 voxels of the grid.
+    const std::int64_t lo = macrocells.visibleFirst()[a], hi = macrocells.visibleLast()[a];
+    const std::int64_t edgeLo = macrocells.first()[a], edgeHi = edgeLo + macrocells.count()[a] - 1;
+    constexpr int kShift = MacrocellGrid::kShift;
+    if (lo > hi) {
+      p.visibleLo[a] = 1;
+      p.visibleHi[a] = 0;
+    } else {
+      p.visibleLo[a] = lo == edgeLo ? -1e30 : double(lo << kShift) - 1.0;
+      p.visibleHi[a] = hi == edgeHi ? 1e30 : double((hi + 1) << kShift) + 1.0;
+    }
   }
   p.distance = macrocells.distance();
 }

@@ -123,6 +123,7 @@ MacrocellGrid::MacrocellGrid(const Brick& brick, ThreadPool* pool) : bounds_(bri
     buildSeconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   distance_.assign(bounds_->layout().size(), 0);  // all visible until classified
+  findVisibleBox();
 }
 
 void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty, ThreadPool* pool) {
@@ -149,6 +150,33 @@ void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty, ThreadP
     });
   });
   if (skipEmpty) chessboardDistance(distance_.data(), count(), pool);
+  findVisibleBox();
+}
+
+void MacrocellGrid::findVisibleBox() {
+  // One pass over the field: each visible macrocell widens the box.
+  const IVec3 n = count();
+  IVec3 lo{n.x, n.y, n.z}, hi{-1, -1, -1};
+  const std::uint8_t* d = distance_.data();
+  for (std::int64_t z = 0; z < n.z; ++z)
+    for (std::int64_t y = 0; y < n.y; ++y) {
+      const std::uint8_t* row = d + (z * n.y + y) * n.x;
+      std::int64_t x0 = 0;
+      while (x0 < n.x && row[x0] != 0) ++x0;
+      if (x0 == n.x) continue;
+      std::int64_t x1 = n.x - 1;
+      while (row[x1] != 0) --x1;
+      lo = {std::min(lo.x, x0), std::min(lo.y, y), std::min(lo.z, z)};
+      hi = {std::max(hi.x, x1), std::max(hi.y, y), std::max(hi.z, z)};
+    }
+  const IVec3 at = first();
+  if (hi.x < 0) {
+    visibleFirst_ = {at.x + 1, at.y + 1, at.z + 1};  // empty: first > last
+    visibleLast_ = at;
+    return;
+  }
+  visibleFirst_ = {at.x + lo.x, at.y + lo.y, at.z + lo.z};
+  visibleLast_ = {at.x + hi.x, at.y + hi.y, at.z + hi.z};
 }
 
 }  // namespace pvr::core

@@ -46,12 +46,21 @@ class MacrocellGrid {
   // macrocell at distance d may leap d - 1 macrocells along its major axis
   // without meeting anything visible (space leaping with a distance field).
   const std::uint8_t* distance() const { return distance_.data(); }
+  // The least box of macrocells holding every visible one, as global
+  // macrocell indices [visibleFirst(), visibleLast()] per axis; empty
+  // (first > last on every axis) when none is visible. Rays never walk the
+  // empty shell around it (kernel::clipToVisible).
+  IVec3 visibleFirst() const { return visibleFirst_; }
+  IVec3 visibleLast() const { return visibleLast_; }
   // Seconds the constructor spent computing bounds (0 when the brick had them).
   double buildSeconds() const { return buildSeconds_; }
 
  private:
+  void findVisibleBox();  // visibleFirst_ and visibleLast_ from distance_
+
   std::shared_ptr<const MacrocellBounds> bounds_;
   std::vector<std::uint8_t> distance_;
+  IVec3 visibleFirst_, visibleLast_;
   double buildSeconds_ = 0;
 };
 

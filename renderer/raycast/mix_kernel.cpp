@@ -80,10 +80,7 @@ bool runMixedSlots(const MixedVolume* volumes, const RaySetup* rays, const int* 
       if (distance == 0) {
         visible = true;
       } else {
-        const std::int64_t leap =
-            distance > 1 ? std::max<std::int64_t>(1, std::int64_t(double(distance - 1) * r.leapPerMacrocell))
-                         : kernel::macrocellExit(r, mc, k, mcShift) - k;
-        advance = std::min(advance, leap);
+        advance = std::min(advance, kernel::emptyExit(r, mc, distance, k, mcShift) - k);
       }
     }
     if (!visible) {

@@ -291,6 +291,23 @@ TEST_CASE("bricks equal the whole: anisotropic spacing", "[bricks]") {
   checkSplitsMatch(volume, tf, camera, makeOptions(1.5, true, true), {4, 9});
 }
 
+// Rays walk only the box of a brick's visible macrocells (kernel::
+// clipToVisible): a blob off in one corner leaves some bricks with no
+// visible macrocell (every ray misses their box) and others with a box
+// that ends at the brick's faces, where the blob runs on into the next.
+TEST_CASE("bricks equal the whole: visible box in some bricks only", "[bricks]") {
+  const GridGeometry grid = cubeGrid(40);
+  const Brick volume = makeVolume(grid, ScalarType::kUInt8, [](Vec3 p) {
+    const Vec3 d = p - Vec3{27, 26, 12};
+    return 255 * std::exp(-dot(d, d) / (2 * 8.0 * 8.0));
+  });
+  TransferFunctionSpec tf;
+  tf.points = {{0, 0, 0, 0, 0}, {50, 0.1, 0.3, 0.9, 0}, {150, 0.8, 0.7, 0.3, 0.3}, {255, 1, 0.9, 0.8, 0.6}};
+  tf.unitDistance = 1.0;
+  checkSplitsMatch(volume, tf, orthographic(grid, {0.5, 0.7, 0.5}, {0, 0, 1}, 96), makeOptions(0.5), {4, 9});
+  checkSplitsMatch(volume, tf, perspective({-25, 60, 45}, {20, 20, 20}, {0, 0, 1}, 50, 96), makeOptions(1.3, true),
+                   {3, 7});
+}
 
 // Quality chosen by error (step_levels.h): every brick reads a block's
 // level at the same points of the global level field and owns the coarse

@@ -1,0 +1,218 @@
+// Empty-space skipping's traversal (renderer/raycast/cast_ray.h): rays
+// start and end their walk at the box of visible macrocells
+// (MacrocellGrid::visibleFirst(), kernel::clipToVisible) and cross the
+// empty cube the distance field proves around a macrocell in one step
+// (kernel::emptyExit). Neither may change the image beyond rounding: a
+// ray's samples in invisible macrocells add nothing, and both only decide
+// which of them the ray walks past.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "raycast/kernel.h"
+#include "raycast/macrocells.h"
+#include "raycast/raycaster.h"
+#include "reference.h"
+#include "transfer.h"
+
+namespace pvr::core {
+namespace {
+
+ThreadPool& pool() {
+  static ThreadPool p(2);
+  return p;
+}
+
+TransferFunctionSpec transfer(std::vector<TransferPoint> points) {
+  TransferFunctionSpec tf;
+  tf.points = std::move(points);
+  tf.unitDistance = 1.0;
+  return tf;
+}
+
+// uint8 values: 0 around, a soft blob of up to 120 in the middle of the
+// 40^3 grid and a speck of 250 at the eight nodes of cell (37, 1, 37), in
+// a corner.
+Brick speckVolume() {
+  const GridGeometry grid = cubeGrid(40);
+  return makeVolume(grid, ScalarType::kUInt8, [](Vec3 p) {
+    const Vec3 blob = p - Vec3{20, 19, 21}, speck = p - Vec3{37.5, 1.5, 37.5};
+    if (std::max({std::abs(speck.x), std::abs(speck.y), std::abs(speck.z)}) < 0.6) return 250.0;
+    return 120.0 * std::exp(-dot(blob, blob) / (2 * 5.0 * 5.0));
+  });
+}
+
+// Opacity only above 200: the speck alone is visible.
+TransferFunctionSpec speckOnly() { return transfer({{0, 0, 0, 0, 0}, {200, 1, 0.5, 0.2, 0}, {250, 1, 0.5, 0.2, 0.9}}); }
+
+// Opacity from 40 up: the blob and the speck.
+TransferFunctionSpec blobAndSpeck() {
+  return transfer({{0, 0, 0, 0, 0}, {40, 0.2, 0.5, 0.9, 0}, {120, 0.4, 0.8, 0.6, 0.3}, {250, 1, 0.5, 0.2, 0.9}});
+}
+
+Image render(const BrickRenderer& r, const Camera& camera, const RenderOptions& o, RenderStats* stats = nullptr) {
+  return r.render(camera, o, pool(), stats).toFullFrame();
+}
+
+double coverage(const Image& image) {
+  double sum = 0;
+  for (const Rgba& p : image.pixels()) sum += p.a;
+  return sum;
+}
+
+// Views of the speck's corner: from outside, grazing the face it is next
+// to, and from inside the volume.
+std::vector<Camera> cornerViews() {
+  return {makeCamera(Projection::kPerspective, {80, -40, 75}, {20, 20, 20}, {0, 0, 1}, 45, 64, 64),
+          makeCamera(Projection::kOrthographic, {20, -60, 38}, {20, 20, 38}, {0, 0, 1}, 60, 64, 64),
+          makeCamera(Projection::kPerspective, {10, 30, 12}, {37, 2, 37}, {0, 0, 1}, 70, 64, 64)};
+}
+
+// The least box of the macrocells whose nodes hold a value the table
+// shows, by brute force: global macrocell indices, lo > hi when none.
+std::pair<IVec3, IVec3> visibleBoxOf(const Brick& volume, const TransferTable& table) {
+  constexpr int kSize = MacrocellGrid::kSize;
+  const IVec3 dims = volume.grid().dims;
+  const auto* v = reinterpret_cast<const std::uint8_t*>(volume.bytes());
+  IVec3 lo{1 << 20, 1 << 20, 1 << 20}, hi{-1, -1, -1};
+  for (std::int64_t mz = 0; mz * kSize < dims.z - 1; ++mz)
+    for (std::int64_t my = 0; my * kSize < dims.y - 1; ++my)
+      for (std::int64_t mx = 0; mx * kSize < dims.x - 1; ++mx) {
+        int least = 255, most = 0;
+        for (std::int64_t z = mz * kSize; z <= std::min(dims.z - 1, (mz + 1) * kSize); ++z)
+          for (std::int64_t y = my * kSize; y <= std::min(dims.y - 1, (my + 1) * kSize); ++y)
+            for (std::int64_t x = mx * kSize; x <= std::min(dims.x - 1, (mx + 1) * kSize); ++x) {
+              const int value = v[(z * dims.y + y) * dims.x + x];
+              least = std::min(least, value);
+              most = std::max(most, value);
+            }
+        if (!table.anyVisible(least, most)) continue;
+        const IVec3 m{mx, my, mz};
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::min(lo[a], m[a]);
+          hi[a] = std::max(hi[a], m[a]);
+        }
+      }
+  return {lo, hi};
+}
+
+}  // namespace
+
+// The box is the least one holding every visible macrocell (global
+// indices), follows each classify() of the same grid (narrow, widened,
+// empty) and holds every macrocell with skipping off.
+TEST_CASE("the visible box holds the visible macrocells of the transfer function in use", "[raycast]") {
+  const Brick volume = speckVolume();
+  MacrocellGrid grid(volume);
+  REQUIRE(grid.count() == IVec3{10, 10, 10});  // 39 cells a side
+
+  // The speck alone: nodes 37..38, 1..2, 37..38 lie in macrocell (9, 0, 9) only.
+  const TransferTable speck(speckOnly(), 0.5);
+  grid.classify(speck, true);
+  CHECK(grid.visibleFirst() == IVec3{9, 0, 9});
+  CHECK(grid.visibleLast() == IVec3{9, 0, 9});
+  CHECK(visibleBoxOf(volume, speck) == std::pair{IVec3{9, 0, 9}, IVec3{9, 0, 9}});
+
+  // Widened by the next transfer function: the blob's macrocells join.
+  const TransferTable both(blobAndSpeck(), 0.5);
+  grid.classify(both, true);
+  const auto [lo, hi] = visibleBoxOf(volume, both);
+  CHECK(grid.visibleFirst() == lo);
+  CHECK(grid.visibleLast() == hi);
+  CHECK(lo.x < 9);
+  CHECK(hi.y > 0);
+
+  grid.classify(TransferTable(transfer({{0, 1, 1, 1, 0}, {255, 1, 1, 1, 0}}), 0.5), true);
+  for (int a = 0; a < 3; ++a) CHECK(grid.visibleFirst()[a] > grid.visibleLast()[a]);
+
+  grid.classify(speck, false);
+  CHECK(grid.visibleFirst() == IVec3{0, 0, 0});
+  CHECK(grid.visibleLast() == IVec3{9, 9, 9});
+}
+
+// Identity: skipping on equals skipping off up to rounding (1e-6), for a
+// speck alone in the corner (the box one macrocell wide: almost every ray
+// misses it and costs nothing) and after a transfer-function change
+// widens the box on the same renderer. Both scenes must show something:
+// a box that left the speck out would leave its pixels black.
+TEST_CASE("a speck in a corner of the volume is still hit after clipping to the visible box", "[raycast]") {
+  const Brick volume = speckVolume();
+  for (const Camera& camera : cornerViews()) {
+    for (bool pre : {false, true}) {
+      for (double step : {0.5, 0.9}) {
+        INFO((pre ? "preintegrated" : "plain") << " step " << step);
+        RenderOptions o = makeOptions(step, pre);
+        BrickRenderer skipping(volume);
+        skipping.classify(speckOnly(), o);
+        RenderStats few;
+        const Image speck = render(skipping, camera, o, &few);
+
+        RenderOptions full = o;
+        full.skipEmpty = false;
+        BrickRenderer walking(volume);
+        walking.classify(speckOnly(), full);
+        RenderStats all;
+        const Image speckFull = render(walking, camera, full, &all);
+        REQUIRE(coverage(speckFull) > 0.1);
+        CHECK(compareImages(speck, speckFull).maxAbs <= 1e-6);
+        CHECK(few.samples * 20 < all.samples);
+
+        // The same renderer, classified again for a transfer function
+        // that shows the blob as well.
+        skipping.classify(blobAndSpeck(), o);
+        walking.classify(blobAndSpeck(), full);
+        const Image both = render(skipping, camera, o);
+        const Image bothFull = render(walking, camera, full);
+        REQUIRE(coverage(bothFull) > coverage(speckFull) + 1);
+        CHECK(compareImages(both, bothFull).maxAbs <= 1e-6);
+      }
+    }
+  }
+}
+
+// emptyExit: every sample before the exit lies in the cube of macrocells
+// within distance - 1 of m (the samples it skips), the exit is at least
+// k + 1, and it leaps at least distance - 1 macrocells along the ray's
+// major axis (what the distance field allowed before). Rays in every
+// octant, axis-parallel and oblique, from anywhere in m.
+TEST_CASE("a ray crosses the empty cube around its macrocell in one leap", "[raycast]") {
+  constexpr int kShift = MacrocellGrid::kShift, kSize = MacrocellGrid::kSize;
+  std::uint32_t seed = 12345;
+  auto uniform = [&] {
+    seed = seed * 1664525u + 1013904223u;
+    return double(seed >> 8) / double(1u << 24);
+  };
+  for (int trial = 0; trial < 2000; ++trial) {
+    Vec3 dir{uniform() - 0.5, uniform() - 0.5, uniform() - 0.5};
+    if (trial % 7 == 0) dir = Vec3{0, 0, 0}, dir[trial % 3] = trial % 2 ? 1.0 : -1.0;
+    dir = normalize(dir);
+    const double step = 0.25 + 2 * uniform();
+    const int m[3] = {10 + int(uniform() * 20), 10 + int(uniform() * 20), 10 + int(uniform() * 20)};
+    const int distance = 1 + int(uniform() * 8);
+    RaySetup r{};
+    double major = 0;
+    const std::int64_t k = std::int64_t(uniform() * 50);
+    for (int a = 0; a < 3; ++a) {
+      r.step[a] = dir[a] * step;
+      r.invStep[a] = r.step[a] != 0 ? 1 / r.step[a] : 0;
+      // Sample k somewhere in macrocell m.
+      r.origin[a] = double(m[a] * kSize) + uniform() * kSize - double(k) * r.step[a];
+      major = std::max(major, std::abs(r.step[a]));
+    }
+    const std::int64_t exit = kernel::emptyExit(r, m, distance, k, kShift);
+    INFO("trial " << trial << " distance " << distance << " k " << k << " exit " << exit);
+    REQUIRE(exit >= k + 1);
+    CHECK(double(exit - k) >= std::floor(double(distance - 1) * kSize / major) - 1e-9);
+    for (std::int64_t s = k; s < exit; ++s)
+      for (int a = 0; a < 3; ++a) {
+        const double u = r.origin[a] + double(s) * r.step[a];
+        CHECK(u >= double((m[a] - distance + 1) * kSize) - 1e-9);
+        CHECK(u <= double((m[a] + distance) * kSize) + 1e-9);
+      }
+  }
+}
+
+}  // namespace pvr::core
