@@ -160,60 +160,118 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
 
 }  // namespace kernel
 
-template <typename T, bool kShaded, bool kPreintegrated>
-RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
-  RayResult out;
-  std::int64_t first, last;
-  if (!kernel::sampleRange(p, ray, first, last)) {
-    // No sample here; the ray may still cross the domain between two samples.
-    double kIn, kOut;
-    if (kernel::shortChord(p, ray, kIn, kOut)) {
-      const double mid = 0.5 * (kIn + kOut);
-      int m[3];
-      for (int a = 0; a < 3; ++a)
-        m[a] = std::clamp(int(ray.origin[a] + mid * ray.step[a]) >> mcShift, p.mcFirst[a],
-                          p.mcFirst[a] + p.mcCount[a] - 1);
-      out.hit = true;
-      kernel::Accumulator acc;
-      if (p.distance[kernel::macrocellIndex(p, m)] == 0)
-        kernel::runSegment<T, kShaded, kPreintegrated>(p, ray, mid, kIn, kOut, acc, out.samples);
-      out.colour = acc.rgba();
-    }
-    return out;
-  }
-  out.hit = true;
-  // The walk starts and ends at the visible box; a ray that misses it
-  // costs nothing more.
-  std::int64_t k = first, end = last;
-  if (!kernel::clipToVisible(p, ray, k, end)) return out;
-  const kernel::ChordEnds ends = kernel::chordEnds(p, ray, first, last);
+namespace kernel {
 
-  const float o[3] = {float(ray.origin[0]), float(ray.origin[1]), float(ray.origin[2])};
-  const float d[3] = {float(ray.step[0]), float(ray.step[1]), float(ray.step[2])};
-  kernel::Accumulator acc;
-  std::int64_t done = first;  // next sample not yet composited or skipped
-  const std::int64_t chunk = kernel::visibleChunk(ray);
-  while (k <= end) {
-    if (const std::int64_t next = kernel::pastEmpty(p, ray, o, d, k, mcShift); next != k) {
-      k = next;
-      continue;
+// One ray's walk through the brick, a look-up at a time: castRay takes
+// one ray's steps in turn; castRays takes the steps of several rays by
+// turns, so that their chains of dependent arithmetic and loads a look-up
+// is (position, macrocell, distance, leap) overlap in the CPU.
+template <typename T, bool kShaded, bool kPreintegrated>
+class RayWalk {
+ public:
+  // Sets the walk up; false when the ray is done already (out holds its
+  // result: no sample here, a short chord, or no visible macrocell).
+  bool start(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
+    if (!sampleRange(p, ray, first_, last_)) {
+      // No sample here; the ray may still cross the domain between two samples.
+      double kIn, kOut;
+      if (shortChord(p, ray, kIn, kOut)) {
+        const double mid = 0.5 * (kIn + kOut);
+        int m[3];
+        for (int a = 0; a < 3; ++a)
+          m[a] = std::clamp(int(ray.origin[a] + mid * ray.step[a]) >> mcShift, p.mcFirst[a],
+                            p.mcFirst[a] + p.mcCount[a] - 1);
+        out.hit = true;
+        if (p.distance[macrocellIndex(p, m)] == 0)
+          runSegment<T, kShaded, kPreintegrated>(p, ray, mid, kIn, kOut, acc_, out.samples);
+        out.colour = acc_.rgba();
+      }
+      return false;
+    }
+    out.hit = true;
+    // The walk starts and ends at the visible box; a ray that misses it
+    // costs nothing more.
+    k_ = first_;
+    end_ = last_;
+    if (!clipToVisible(p, ray, k_, end_)) return false;
+    ends_ = chordEnds(p, ray, first_, last_);
+    for (int a = 0; a < 3; ++a) {
+      o_[a] = float(ray.origin[a]);
+      d_[a] = float(ray.step[a]);
+    }
+    done_ = first_;
+    chunk_ = visibleChunk(ray);
+    return true;
+  }
+
+  // One look-up, and a chunk of samples where it finds something visible.
+  // False when the ray is done (out holds its result).
+  bool step(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
+    if (const std::int64_t next = pastEmpty(p, ray, o_, d_, k_, mcShift); next != k_) {
+      k_ = next;
+      return k_ <= end_ || finish(out);
     }
     // Something visible: sample a fixed chunk and look again. Samples that
     // run on into an empty macrocell add nothing, and a chunk costs one
     // look-up where walking the visible macrocells exactly (a 3D DDA)
     // mispredicted a branch at nearly every macrocell face.
-    const std::int64_t exit = std::min(last + 1, k + chunk);
+    const std::int64_t exit = std::min(last_ + 1, k_ + chunk_);
     // A pre-integrated segment runs from one sample to the next: when the
     // sample before this run was skipped, its segment ends in here.
-    std::int64_t start = k;
-    if constexpr (kPreintegrated) start = (done < k) ? std::max(first, k - 1) : k;
-    if (kernel::runSpan<T, kShaded, kPreintegrated>(p, ray, ends, start, exit, acc, out.samples))
-      break;
-    done = exit;
-    k = exit;
+    std::int64_t start = k_;
+    if constexpr (kPreintegrated) start = (done_ < k_) ? std::max(first_, k_ - 1) : k_;
+    if (runSpan<T, kShaded, kPreintegrated>(p, ray, ends_, start, exit, acc_, out.samples)) return finish(out);
+    done_ = exit;
+    k_ = exit;
+    return k_ <= end_ || finish(out);
   }
-  out.colour = acc.rgba();
+
+ private:
+  bool finish(RayResult& out) const {
+    out.colour = acc_.rgba();
+    return false;
+  }
+
+  std::int64_t first_ = 0, last_ = -1;  // the ray's samples in the brick
+  std::int64_t k_ = 0, end_ = -1;       // the next sample to look at; the last in the visible box
+  std::int64_t done_ = 0;               // next sample not yet composited or skipped
+  std::int64_t chunk_ = 0;
+  ChordEnds ends_;
+  float o_[3], d_[3];  // the ray's origin and step in float, as the samples'
+  Accumulator acc_;
+};
+
+}  // namespace kernel
+
+template <typename T, bool kShaded, bool kPreintegrated>
+RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
+  RayResult out;
+  kernel::RayWalk<T, kShaded, kPreintegrated> walk;
+  if (walk.start(p, ray, mcShift, out))
+    while (walk.step(p, ray, mcShift, out)) {
+    }
   return out;
+}
+
+// Rays rays[0, n) into out[0, n), n <= kRaysAtOnce: their walks by
+// turns, a step of each (see RayWalk), each ray as castRay would take it.
+template <typename T, bool kShaded, bool kPreintegrated>
+void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, RayResult* out) {
+  kernel::RayWalk<T, kShaded, kPreintegrated> walk[kRaysAtOnce];
+  bool going[kRaysAtOnce];
+  int left = 0;
+  for (int i = 0; i < n; ++i) {
+    out[i] = RayResult{};
+    going[i] = walk[i].start(p, rays[i], mcShift, out[i]);
+    left += going[i];
+  }
+  while (left > 0) {
+    for (int i = 0; i < n; ++i) {
+      if (!going[i]) continue;
+      going[i] = walk[i].step(p, rays[i], mcShift, out[i]);
+      left -= !going[i];
+    }
+  }
 }
 
 }  // namespace pvr::core

@@ -76,6 +76,12 @@ struct RaySetup {
   float halfway[3];   // Blinn-Phong half vector, world space
 };
 
+// Rays a caster takes at once, neighbours along a row (castRays in
+// cast_ray.h, renderTileRuns in tiles.h): a ray's walk through empty space
+// is a chain of dependent look-ups, and the walks of four rays by turns
+// overlap in the CPU (peer scene: 10-15 % less CPU time than one at a time).
+inline constexpr int kRaysAtOnce = 4;
+
 struct RayResult {
   Rgba colour;
   std::uint64_t samples = 0;

@@ -16,13 +16,20 @@ namespace pvr::core {
 
 namespace {
 
-using RayFunction = RayResult (*)(const KernelParams&, const RaySetup&, int);
+// Casts rays[0, n) into out[0, n), n <= kRaysAtOnce.
+using RayFunction = void (*)(const KernelParams&, const RaySetup*, int, int, RayResult*);
 
 // The one place configuration picks a kernel instantiation.
 template <typename T>
 RayFunction pickKernel(bool shaded, bool preintegrated) {
-  if (shaded) return preintegrated ? &castRay<T, true, true> : &castRay<T, true, false>;
-  return preintegrated ? &castRay<T, false, true> : &castRay<T, false, false>;
+  if (shaded) return preintegrated ? &castRays<T, true, true> : &castRays<T, true, false>;
+  return preintegrated ? &castRays<T, false, true> : &castRays<T, false, false>;
+}
+
+// A kernel of one ray at a time as a RayFunction.
+template <RayResult (*kCast)(const KernelParams&, const RaySetup&, int)>
+void oneByOne(const KernelParams& p, const RaySetup* rays, int n, int mcShift, RayResult* out) {
+  for (int i = 0; i < n; ++i) out[i] = kCast(p, rays[i], mcShift);
 }
 
 RayFunction pickKernel(ScalarType type, bool shaded, bool preintegrated) {
@@ -36,7 +43,7 @@ RayFunction pickKernel(ScalarType type, bool shaded, bool preintegrated) {
 RayFunction pickLevelKernel(ScalarType type, bool shaded) {
   return dispatchScalar(type, [&](auto tag) -> RayFunction {
     using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
-    return shaded ? &castRayByLevels<T, true> : &castRayByLevels<T, false>;
+    return shaded ? &oneByOne<&castRayByLevels<T, true>> : &oneByOne<&castRayByLevels<T, false>>;
   });
 }
 
@@ -136,9 +143,10 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
 
   // Tiles of the rectangle over the pool; each worker counts its own work.
   RenderStats counted;
-  renderTiles(image, options, pool, [&](int x, int y) {
-    const RaySetup s = raySetup(camera.ray(x, y), grid, step, lightWorld);
-    return cast(p, s, MacrocellGrid::kShift);
+  renderTileRuns(image, options, pool, [&](int x, int y, int n, RayResult* out) {
+    RaySetup rays[kRaysAtOnce];
+    for (int i = 0; i < n; ++i) rays[i] = raySetup(camera.ray(x + i, y), grid, step, lightWorld);
+    cast(p, rays, n, MacrocellGrid::kShift, out);
   }, counted);
   if (stats) {
     *stats = counted;

@@ -16,13 +16,14 @@ namespace pvr::core {
 
 inline constexpr int kTileSize = 16;
 
-// Calls castPixel(x, y) -> RayResult for every pixel of image.rect() and
-// stores its colour; adds up samples and the rays that hit into `stats`
-// (seconds are the caller's). Throws Error kCancelled once options.stop
-// reads true (tiles not yet started are skipped).
-template <typename CastPixel>
-void renderTiles(Image& image, const RenderOptions& options, ThreadPool& pool, const CastPixel& castPixel,
-                 RenderStats& stats) {
+// Calls castRun(x, y, n, out) for runs of n <= kRaysAtOnce pixels (x, y),
+// (x + 1, y), ... of every row of image.rect(), which fills out[0, n), and
+// stores their colours; adds up samples and the rays that hit into
+// `stats` (seconds are the caller's). Throws Error kCancelled once
+// options.stop reads true (tiles not yet started are skipped).
+template <typename CastRun>
+void renderTileRuns(Image& image, const RenderOptions& options, ThreadPool& pool, const CastRun& castRun,
+                    RenderStats& stats) {
   const PixelRect r = image.rect();
   const int tilesX = (r.width() + kTileSize - 1) / kTileSize;
   const int tilesY = (r.height() + kTileSize - 1) / kTileSize;
@@ -35,11 +36,15 @@ void renderTiles(Image& image, const RenderOptions& options, ThreadPool& pool, c
     const int x1 = std::min(r.x1, x0 + kTileSize), y1 = std::min(r.y1, y0 + kTileSize);
     std::uint64_t samples = 0, rays = 0;
     for (int y = y0; y < y1; ++y) {
-      for (int x = x0; x < x1; ++x) {
-        const RayResult res = castPixel(x, y);
-        image.at(x, y) = res.colour;
-        samples += res.samples;
-        rays += res.hit ? 1 : 0;
+      for (int x = x0; x < x1; x += kRaysAtOnce) {
+        const int n = std::min(kRaysAtOnce, x1 - x);
+        RayResult res[kRaysAtOnce];
+        castRun(x, y, n, res);
+        for (int i = 0; i < n; ++i) {
+          image.at(x + i, y) = res[i].colour;
+          samples += res[i].samples;
+          rays += res[i].hit ? 1 : 0;
+        }
       }
     }
     totalSamples += samples;
@@ -49,6 +54,15 @@ void renderTiles(Image& image, const RenderOptions& options, ThreadPool& pool, c
   if (stopped()) throw Error(ErrorCode::kCancelled, "cancelled");
   stats.samples = totalSamples;
   stats.rays = totalRays;
+}
+
+// renderTileRuns for a caster of one pixel at a time: castPixel(x, y) -> RayResult.
+template <typename CastPixel>
+void renderTiles(Image& image, const RenderOptions& options, ThreadPool& pool, const CastPixel& castPixel,
+                 RenderStats& stats) {
+  renderTileRuns(image, options, pool, [&](int x, int y, int n, RayResult* out) {
+    for (int i = 0; i < n; ++i) out[i] = castPixel(x + i, y);
+  }, stats);
 }
 
 }  // namespace pvr::core

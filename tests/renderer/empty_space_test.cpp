@@ -12,7 +12,9 @@
 #include <utility>
 #include <vector>
 
+#include "raycast/cast_ray.h"
 #include "raycast/kernel.h"
+#include "raycast/kernel_setup.h"
 #include "raycast/macrocells.h"
 #include "raycast/raycaster.h"
 #include "reference.h"
@@ -212,6 +214,64 @@ TEST_CASE("a ray crosses the empty cube around its macrocell in one leap", "[ray
         CHECK(u >= double((m[a] - distance + 1) * kSize) - 1e-9);
         CHECK(u <= double((m[a] + distance) * kSize) + 1e-9);
       }
+  }
+}
+
+// castRays takes up to kRaysAtOnce rays' walks by turns: each ray's
+// result must be exactly castRay's for it (colour, samples, hit), whatever
+// its neighbours do: rays that miss the brick, miss the visible box, cross
+// the speck, the blob, or stop early at the early-termination opacity, in
+// runs of every length; plain, pre-integrated and shaded.
+TEST_CASE("rays cast by turns equal rays cast one at a time", "[raycast]") {
+  const Brick volume = speckVolume();
+  const TransferFunctionSpec tf = blobAndSpeck();
+  const Camera camera = makeCamera(Projection::kPerspective, {70, -35, 60}, {22, 18, 24}, {0, 0, 1}, 22, 40, 40);
+  for (bool pre : {false, true}) {
+    for (bool shaded : {false, true}) {
+      INFO((pre ? "preintegrated" : "plain") << (shaded ? " shaded" : ""));
+      RenderOptions o = makeOptions(0.6, pre, shaded);
+      o.earlyTermination = 0.5;
+      MacrocellGrid macrocells(volume);
+      const TransferTable table(tf, o.step);
+      const PreintegratedTable preintegrated(tf);
+      macrocells.classify(table, true);
+      KernelParams p;
+      setBrick(p, volume, macrocells);
+      setTables(p, table, pre ? &preintegrated : nullptr, o.step);
+      const std::vector<float> specular = specularTable(o.shading.shininess);
+      setOptions(p, o, specular.data());
+      const Vec3 light = normalize(camera.toWorld(o.shading.lightDirection));
+      auto one = pre ? (shaded ? &castRay<std::uint8_t, true, true> : &castRay<std::uint8_t, false, true>)
+                     : (shaded ? &castRay<std::uint8_t, true, false> : &castRay<std::uint8_t, false, false>);
+      auto turns = pre ? (shaded ? &castRays<std::uint8_t, true, true> : &castRays<std::uint8_t, false, true>)
+                       : (shaded ? &castRays<std::uint8_t, true, false> : &castRays<std::uint8_t, false, false>);
+      int hits = 0, terminated = 0;
+      for (int y = 0; y < camera.height(); ++y) {
+        for (int x = 0, n = 1; x < camera.width(); x += n, n = n % kRaysAtOnce + 1) {
+          const int count = std::min(n, camera.width() - x);
+          RaySetup rays[kRaysAtOnce];
+          for (int i = 0; i < count; ++i) rays[i] = raySetup(camera.ray(x + i, y), volume.grid(), o.step, light);
+          RayResult together[kRaysAtOnce];
+          turns(p, rays, count, MacrocellGrid::kShift, together);
+          for (int i = 0; i < count; ++i) {
+            const RayResult alone = one(p, rays[i], MacrocellGrid::kShift);
+            INFO("pixel " << x + i << ", " << y);
+            CHECK(together[i].hit == alone.hit);
+            CHECK(together[i].samples == alone.samples);
+            CHECK(together[i].colour.r == alone.colour.r);
+            CHECK(together[i].colour.g == alone.colour.g);
+            CHECK(together[i].colour.b == alone.colour.b);
+            CHECK(together[i].colour.a == alone.colour.a);
+            hits += alone.samples > 0;
+            terminated += alone.colour.a >= 0.5f;
+          }
+        }
+      }
+      // The view must hold every kind of ray for the check to mean anything.
+      CHECK(hits > 100);
+      CHECK(hits < camera.width() * camera.height() - 100);
+      CHECK(terminated > 10);
+    }
   }
 }
 
