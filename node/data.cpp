@@ -148,17 +148,40 @@ void agreeOnValueRange(NodeState& state, const std::optional<comm::Failure>& fai
     summary = summaries.front();
   } else {
     const core::Brick* brick = state.current ? &state.current->brick : nullptr;
-    summary = summarizeData(state.world, brick, countsForHistogram(state));
+    summary = summarizeData(state.world, brick, false);  // the range; the histogram when asked (countHistogram)
   }
   state.valueRange.reset();
   state.histogram.clear();
+  state.histogramPending = false;
   if (summary) {
     state.valueRange = summary->range;
-    state.histogram = summary->histogram;
+    if (state.several()) state.histogram = summary->histogram;
+    else state.histogramPending = true;
   }
   if (failure) throw comm::FailureError(*failure);
   applyDataDefaults(state);
 }
+
+}  // namespace
+
+void countHistogram(NodeState& state) {
+  if (!state.histogramPending) return;
+  core::Brick* brick = state.current ? &state.current->brick : nullptr;
+  const bool counts = countsForHistogram(state);
+  std::optional<comm::Failure> failure;
+  try {
+    if (brick && counts) brick->countFineHistogram(state.pool.get());
+  } catch (...) {
+    failure = comm::failureOf(std::current_exception(), state.world.rank());
+  }
+  // Every rank takes part in the sums, then a rank that failed throws.
+  const auto summary = summarizeData(state.world, brick, counts && !failure);
+  state.histogram = summary ? summary->histogram : std::vector<std::uint64_t>{};
+  state.histogramPending = false;
+  if (failure) throw comm::FailureError(*failure);
+}
+
+namespace {
 
 void collectFailure(NodeState& state, const std::function<void()>& phase) {
   std::optional<comm::Failure> failure;
@@ -261,6 +284,7 @@ Reload openScene(NodeState& state, const std::string& sceneJson) {
     // Only what lies inside the data directory: the client named it.
     const core::DataDirectory within(state.dataDir);
     source = openNodeVolume(scene.volumes.front().source, &within);
+    source->setFineCounts(false);  // counted when first asked for (countHistogram)
     grid = source.get();
   }
   core::checkTimestep(scene.volumes.front().source, *grid);

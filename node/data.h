@@ -40,6 +40,11 @@ void distributeData(NodeState& state);
 // (showStep), then every rank learns its value range, as loadBricks.
 void loadStep(NodeState& state);
 
+// Collective over the world: the histogram of the data on screen when a
+// load left it to be counted (NodeState::histogramPending), over the first
+// render cluster's bricks; a no-op otherwise.
+void countHistogram(NodeState& state);
+
 // Collective over my render cluster (no-op elsewhere): makes `step` the
 // brick on screen, from the cache, read on demand, or by a distribution
 // when the format cannot read a box alone. Read and preprocessing time of a

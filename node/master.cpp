@@ -121,6 +121,10 @@ std::optional<proto::ProtocolError> Master::applyScene(const proto::SetScene& re
 }
 
 void Master::on(const proto::StatusRequest&, std::uint32_t id) {
+  // The histogram a load left uncounted, now that someone asks (the link
+  // thread answers from its snapshot, without it, while renders run ahead).
+  if (state_.histogramPending)
+    if (auto f = invoke(state_, actions::CountHistogram{})) return sendError(wireError(*f, state_.hosts), id);
   send(status(), id);
 }
 

@@ -131,8 +131,13 @@ struct NodeState {
   // (re)distribution (loadBricks), on every rank.
   std::optional<std::array<double, 2>> valueRange;
   // Its histogram, core::kHistogramBins bins over valueRange (data_summary.h),
-  // counted over the first render cluster's bricks; empty without data.
+  // counted over the first render cluster's bricks; empty without data, and
+  // while histogramPending: a load counts nothing (a first frame does not
+  // need the counts, and counting costs as much again as the rest of
+  // preprocessing); the first Status the master answers counts them
+  // (countHistogram).
   std::vector<std::uint64_t> histogram;
+  bool histogramPending = false;
 
   // The wave in flight.
   std::vector<WaveFrame> wave;

@@ -1,7 +1,7 @@
 // Session: `:s info`, the loaded dataset as a Tcl dict, from the server's
 // status entries (node/status.cpp): dims, spacing, origin, bounds, dtype,
-// range and the 256-bin histogram the server counted when it loaded the
-// data. What the GUI's transfer-function editor draws; no file is read here.
+// range and the 256-bin histogram the server counts when it is first asked
+// after loading the data. What the GUI's transfer-function editor draws; no file is read here.
 #include <utility>
 
 #include "session.h"

@@ -127,6 +127,12 @@ void Brick::updateValueRange(ThreadPool* pool) {
   loadTimes_.preprocess += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+void Brick::countFineHistogram(ThreadPool* pool) {
+  if (histogram_) return;
+  const NodeBox counted = countedBox(owned_, grid_);
+  histogram_ = preprocessVoxels(type_, owned_, stored_, std::as_const(*this).bytes(), pool, &counted).histogram;
+}
+
 void Brick::setPreprocessed(const ValueRange& range, std::shared_ptr<const MacrocellBounds> bounds,
                             std::shared_ptr<const FineHistogram> histogram) {
   if (!bounds || bounds->type() != type_ || !(bounds->layout() == MacrocellLayout::forOwned(owned_)))

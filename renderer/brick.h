@@ -104,6 +104,10 @@ class Brick {
   // Fine counts of the voxels this brick counts (countedBox(owned, grid)),
   // or null when storage was written since, or a reader gave none.
   const std::shared_ptr<const FineHistogram>& fineHistogram() const { return histogram_; }
+  // Counts them now if no reader did (a reader told to count nothing: the
+  // server counts when the histogram is first asked for, not before the
+  // first frame). Leaves range and bounds as they are.
+  void countFineHistogram(ThreadPool* pool = nullptr);
   // The macrocell bounds of the owned box, or null when storage was written
   // since they were computed (or they never were). Shared, never copied:
   // the renderer's MacrocellGrid holds the same object.

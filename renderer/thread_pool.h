@@ -5,6 +5,7 @@
 // themselves. The calling thread works too; workers sleep between loops.
 #pragma once
 
+#include <algorithm>
 #include <condition_variable>
 #include <cstddef>
 #include <functional>
@@ -43,5 +44,18 @@ class ThreadPool {
   bool stop_ = false;
   std::exception_ptr error_;
 };
+
+// Runs body(begin, end) over contiguous chunks of [0, n): a few chunks per
+// thread of the pool (so uneven chunks still balance), or the whole range
+// on the calling thread when there is no pool.
+template <typename F>
+void forChunks(std::size_t n, ThreadPool* pool, F&& body) {
+  const std::size_t chunks = pool ? std::min<std::size_t>(n, std::size_t(pool->size()) * 4) : 1;
+  if (chunks <= 1) {
+    if (n > 0) body(std::size_t(0), n);
+    return;
+  }
+  pool->parallelFor(chunks, [&](std::size_t c, int) { body(n * c / chunks, n * (c + 1) / chunks); });
+}
 
 }  // namespace pvr::core

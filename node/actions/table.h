@@ -80,6 +80,14 @@ struct ReportCache {
   static void run(NodeState& state, const ReportCache& args);
 };
 
+// The data's histogram, counted the first time a Status asks after a load
+// (data.h countHistogram; count_histogram.cpp).
+struct CountHistogram {
+  static constexpr std::string_view kName = "count_histogram";
+  static auto fields(auto&) { return std::tie(); }
+  static void run(NodeState& state, const CountHistogram& args);
+};
+
 // Dataset bytes per rank and cluster, into state.reply (report_memory.cpp).
 struct ReportMemory {
   static constexpr std::string_view kName = "report_memory";
@@ -109,6 +117,7 @@ using ActionTable = ActionList<
     actions::Wave,
     actions::ReportMemory,
     actions::CompLatency,
-    actions::ReportCache>;
+    actions::ReportCache,
+    actions::CountHistogram>;
 
 }  // namespace pvr::node

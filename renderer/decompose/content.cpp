@@ -152,16 +152,9 @@ ContentGrid countContent(const Brick& brick, const TransferTable& table, IVec3 b
           }
         }
     };
-    const std::size_t layers = std::size_t(lastBlock.z - firstBlock.z + 1);
-    const std::size_t chunks = pool ? std::min<std::size_t>(layers, std::size_t(pool->size()) * 4) : 1;
-    if (chunks <= 1) {
-      countLayers(firstBlock.z, lastBlock.z + 1);
-    } else {
-      pool->parallelFor(chunks, [&](std::size_t k, int) {
-        countLayers(firstBlock.z + std::int64_t(layers * k / chunks),
-                    firstBlock.z + std::int64_t(layers * (k + 1) / chunks));
-      });
-    }
+    forChunks(std::size_t(lastBlock.z - firstBlock.z + 1), pool, [&](std::size_t b, std::size_t e) {
+      countLayers(firstBlock.z + std::int64_t(b), firstBlock.z + std::int64_t(e));
+    });
   });
   return c;
 }

@@ -5,23 +5,13 @@
 #include <limits>
 
 #include "../preprocess.h"
+#include "leap_distance.h"
 
 namespace pvr::core {
 
 namespace {
 
 constexpr int kFar = 255;  // the distance field's cap: "255 or farther"
-
-// Runs body(begin, end) over chunks of [0, n), over the pool when there is one.
-template <typename F>
-void forChunks(std::size_t n, ThreadPool* pool, F&& body) {
-  const std::size_t chunks = pool ? std::min<std::size_t>(n, std::size_t(pool->size()) * 4) : 1;
-  if (chunks <= 1) {
-    if (n > 0) body(std::size_t(0), n);
-    return;
-  }
-  pool->parallelFor(chunks, [&](std::size_t c, int) { body(n * c / chunks, n * (c + 1) / chunks); });
-}
 
 // The 1-D min-max transform of a line, in place:
 //   d(i) = min(255, min over q of max(|i - q|, f(q))).
@@ -133,15 +123,29 @@ void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty, ThreadP
     using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
     const T* mn = bounds_->min<T>();
     const T* mx = bounds_->max<T>();
-    // uint8 bounds take their answer from a table of every (min, max) pair.
-    std::vector<std::uint8_t> pairVisible;
-    if constexpr (std::is_same_v<T, std::uint8_t>) {
-      pairVisible.assign(256 * 256, 0);
-      for (int lo = 0; lo < 256; ++lo)
-        for (int hi = lo; hi < 256; ++hi) pairVisible[std::size_t(lo * 256 + hi)] = table.anyVisible(lo, hi);
+    // Integer bounds of 16 bits or fewer: for each minimum, the least
+    // maximum whose range shows something (a wider range shows at least
+    // as much, so it grows with the minimum and one sweep finds them all);
+    // a macrocell is then one look-up and a compare. An empty macrocell
+    // (min > max) compares below its own minimum's entry.
+    constexpr bool kTabled = std::is_integral_v<T> && sizeof(T) <= 2;
+    constexpr std::int64_t kLowest = [] {
+      if constexpr (kTabled) return std::int64_t(std::numeric_limits<T>::lowest());
+      else return std::int64_t(0);
+    }();
+    std::vector<std::int32_t> leastShownMax;
+    if constexpr (kTabled) {
+      constexpr std::int64_t kValues = std::int64_t(1) << (8 * sizeof(T));
+      leastShownMax.resize(std::size_t(kValues));
+      std::int64_t hi = 0;
+      for (std::int64_t lo = 0; lo < kValues; ++lo) {
+        hi = std::max(hi, lo);
+        while (hi < kValues && !table.anyVisible(double(lo + kLowest), double(hi + kLowest))) ++hi;
+        leastShownMax[std::size_t(lo)] = std::int32_t(hi);
+      }
     }
     auto visible = [&](std::size_t i) -> bool {
-      if constexpr (std::is_same_v<T, std::uint8_t>) return pairVisible[std::size_t(mn[i]) * 256 + mx[i]];
+      if constexpr (kTabled) return std::int64_t(mx[i]) - kLowest >= leastShownMax[std::size_t(std::int64_t(mn[i]) - kLowest)];
       else return mn[i] <= mx[i] && table.anyVisible(double(mn[i]), double(mx[i]));
     };
     forChunks(n / std::max<std::size_t>(layer, 1), pool, [&](std::size_t b, std::size_t e) {
@@ -149,7 +153,7 @@ void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty, ThreadP
         distance_[i] = !skipEmpty || visible(i) ? 0 : kFar;
     });
   });
-  if (skipEmpty) chessboardDistance(distance_.data(), count(), pool);
+  if (skipEmpty) leapDistance(distance_.data(), count(), pool);
   findVisibleBox();
 }
 

@@ -8,7 +8,7 @@
 // Small macrocells (4^3 cells) keep thin visible structures from dragging
 // whole blocks of empty space into the sample loop. Classification against
 // a transfer function is one O(1) query per macrocell and a separable
-// distance transform, cheap enough to redo on every transfer-function
+// distance field (leap_distance.h), cheap enough to redo on every transfer-function
 // change.
 #pragma once
 
@@ -42,9 +42,10 @@ class MacrocellGrid {
   IVec3 count() const { return bounds_->layout().count; }  // macrocells per axis
   const MacrocellBounds& bounds() const { return *bounds_; }
   // Chessboard distance, in macrocells, from each macrocell to the nearest
-  // visible one: 0 for a visible macrocell, capped at 255. A ray in a
-  // macrocell at distance d may leap d - 1 macrocells along its major axis
-  // without meeting anything visible (space leaping with a distance field).
+  // visible one: 0 for a visible macrocell, exact below kLeapNear, beyond
+  // it a lower bound (leap_distance.h), at most 255. A ray in a macrocell at
+  // distance d may leap d - 1 macrocells along its major axis without
+  // meeting anything visible (space leaping with a distance field).
   const std::uint8_t* distance() const { return distance_.data(); }
   // The least box of macrocells holding every visible one, as global
   // macrocell indices [visibleFirst(), visibleLast()] per axis; empty

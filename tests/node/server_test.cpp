@@ -43,6 +43,7 @@
 #include "secure_channel.h"
 #include "strategy.h"
 #include "thread_pool.h"
+#include "value_histogram.h"
 
 namespace {
 
@@ -429,12 +430,17 @@ void checkSequence(Job& job, std::uint32_t request, int frames, int steps, const
   checkFrames(job, request, frames, [&](int k) { return ref.frame(k, steps); });
 }
 
+// A status reply's entries as a map.
+std::map<std::string, std::string> entriesOf(const proto::StatusReply& reply) {
+  std::map<std::string, std::string> out;
+  for (const auto& kv : reply.entries) out[kv.key] = kv.value;
+  return out;
+}
+
 // "list status" as a map.
 std::map<std::string, std::string> statusOf(Job& job) {
   job.send(proto::StatusRequest{});
-  std::map<std::string, std::string> out;
-  for (const auto& kv : job.expect<proto::StatusReply>().entries) out[kv.key] = kv.value;
-  return out;
+  return entriesOf(job.expect<proto::StatusReply>());
 }
 
 // The numbers of a Tcl list of numbers.
@@ -945,7 +951,7 @@ std::map<int, pid_t> rankPids(const Job& job) {
 
 }  // namespace
 
-TEST_CASE_METHOD(Fixture, "a StatusRequest sent during a long frame is answered before the frame") {
+TEST_CASE_METHOD(Fixture, "a StatusRequest sent during a long frame is answered before the frame, the histogram counted by the next") {
   Job job(2);
   openSlowSession(job, 2);
   const auto render = job.send(proto::RenderFrame{});
@@ -954,11 +960,21 @@ TEST_CASE_METHOD(Fixture, "a StatusRequest sent during a long frame is answered 
   auto first = job.receive();
   REQUIRE(first);
   CHECK(first->info.requestId == status);
-  CHECK(std::holds_alternative<proto::StatusReply>(first->message));
+  REQUIRE(std::holds_alternative<proto::StatusReply>(first->message));
+  // The load counted no histogram (the first frame does not need it).
+  auto snapshot = entriesOf(std::get<proto::StatusReply>(first->message));
+  CHECK(snapshot["histogram"].empty());
+  CHECK_FALSE(snapshot["value_range"].empty());
   auto frame = job.receive(120);
   REQUIRE(frame);
   CHECK(frame->info.requestId == render);
   CHECK(std::holds_alternative<proto::ImageFrame>(frame->message));
+  // The master answers the next status and counts first: each voxel once.
+  const auto bins = numbers(statusOf(job)["histogram"]);
+  CHECK(bins.size() == std::size_t(core::kHistogramBins));
+  double counted = 0;
+  for (double n : bins) counted += n;
+  CHECK(counted == double(kDims[0]) * kDims[1] * kDims[2]);
   CHECK(job.close());
 }
 

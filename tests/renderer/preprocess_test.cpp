@@ -20,6 +20,7 @@
 #include "decompose/content.h"
 #include "io/volume_io.h"
 #include "preprocess.h"
+#include "raycast/leap_distance.h"
 #include "raycast/macrocells.h"
 #include "raycast/raycaster.h"
 #include "test_files.h"
@@ -288,6 +289,42 @@ TEST_CASE("the separable distance field equals brute-force chessboard distance",
     }
 }
 
+// A leap distance (leap_distance.h) against the exact chessboard distance:
+// zero exactly where visible, exact below kLeapNear, beyond it never more
+// than the truth and less by at most the coarse blocks' slack.
+static void checkLeapDistance(const std::uint8_t* got, const std::vector<std::uint8_t>& exact) {
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < exact.size(); ++i) {
+    const int want = exact[i], d = got[i];
+    const bool ok = want < kLeapNear ? d == want : (d >= kLeapNear && d <= want && d >= want - 2 * (kLeapBlock - 1));
+    if (!ok && wrong++ < 5) FAIL_CHECK("macrocell " << i << ": leap distance " << d << ", exact " << want);
+  }
+  CHECK(wrong == 0);
+}
+
+TEST_CASE("the leap distance is exact near what is visible and a close lower bound far from it", "[preprocess]") {
+  ThreadPool pool(2);
+  std::mt19937 rng(5);
+  // Several coarse blocks per axis, partial blocks at the ends, and a run
+  // longer than the 255 cap.
+  const IVec3 shapes[] = {{70, 45, 38}, {1, 1, 300}, {300, 2, 3}, {33, 1, 80}, {16, 16, 16}};
+  for (const IVec3 n : shapes)
+    for (double density : {0.0, 0.00005, 0.0005, 0.01, 0.3, 1.0}) {
+      CAPTURE(n.x, n.y, n.z, density);
+      std::vector<std::uint8_t> visible(std::size_t(n.product()));
+      std::bernoulli_distribution coin(density);
+      for (auto& v : visible) v = coin(rng);
+      if (density == 0.00005) visible[0] = 1;  // one speck in a corner
+      const auto exact = fastDistance(visible, n, nullptr);
+      for (ThreadPool* p : {static_cast<ThreadPool*>(nullptr), &pool}) {
+        std::vector<std::uint8_t> d(visible.size());
+        for (std::size_t i = 0; i < d.size(); ++i) d[i] = visible[i] ? 0 : 255;
+        leapDistance(d.data(), n, p);
+        checkLeapDistance(d.data(), exact);
+      }
+    }
+}
+
 TEST_CASE("the distance field caps at 255 along a long empty line", "[preprocess]") {
   // One visible macrocell at x = 0 of 300: distances 0, 1, ..., 254, 255, 255, ...
   const IVec3 n{300, 2, 3};
@@ -315,9 +352,9 @@ TEST_CASE("classification marks a macrocell visible exactly when its bounds are"
     std::vector<std::uint8_t> visible(std::size_t(n.product()));
     for (std::size_t i = 0; i < visible.size(); ++i)
       visible[i] = bounds.minAt(i) <= bounds.maxAt(i) && table.anyVisible(bounds.minAt(i), bounds.maxAt(i));
-    const auto want = bruteForceDistance(visible, n);
-    CHECK(std::equal(want.begin(), want.end(), single.distance()));
-    CHECK(std::equal(want.begin(), want.end(), threaded.distance()));
+    const auto exact = bruteForceDistance(visible, n);
+    checkLeapDistance(single.distance(), exact);
+    CHECK(std::equal(single.distance(), single.distance() + exact.size(), threaded.distance()));
     // The grid shares the brick's bounds instead of copying them.
     CHECK(&single.bounds() == b.macrocellBounds().get());
   }
