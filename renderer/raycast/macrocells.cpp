@@ -79,6 +79,16 @@ class MinMaxLines {
   std::vector<std::uint8_t> forward_;
 };
 
+// out[i] = 0 where macrocell i shows something, else kFar: least[v] is the
+// least maximum that shows something for minimum v. A function of its own
+// so that restrict holds: a byte store may alias anything, and in the
+// classify lambda each one made the loop reload every pointer it captured.
+template <typename T>
+void markShown(const T* __restrict mn, const T* __restrict mx, const std::int32_t* __restrict least,
+               std::uint8_t* __restrict out, std::size_t begin, std::size_t end) {
+  for (std::size_t i = begin; i < end; ++i) out[i] = std::int32_t(mx[i]) >= least[mn[i]] ? 0 : kFar;
+}
+
 }  // namespace
 
 void chessboardDistance(std::uint8_t* d, IVec3 count, ThreadPool* pool) {
@@ -117,6 +127,11 @@ MacrocellGrid::MacrocellGrid(const Brick& brick, ThreadPool* pool) : bounds_(bri
 }
 
 void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty, ThreadPool* pool) {
+  if (!skipEmpty) {
+    std::fill(distance_.begin(), distance_.end(), std::uint8_t(0));  // every macrocell sampled
+    findVisibleBox();
+    return;
+  }
   const std::size_t n = distance_.size();
   const std::size_t layer = std::size_t(count().x * count().y);
   dispatchScalar(bounds_->type(), [&](auto tag) {
@@ -141,19 +156,20 @@ void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty, ThreadP
       for (std::int64_t lo = 0; lo < kValues; ++lo) {
         hi = std::max(hi, lo);
         while (hi < kValues && !table.anyVisible(double(lo + kLowest), double(hi + kLowest))) ++hi;
-        leastShownMax[std::size_t(lo)] = std::int32_t(hi);
+        leastShownMax[std::size_t(lo)] = std::int32_t(hi + kLowest);  // as a value, like the bounds
       }
     }
-    auto visible = [&](std::size_t i) -> bool {
-      if constexpr (kTabled) return std::int64_t(mx[i]) - kLowest >= leastShownMax[std::size_t(std::int64_t(mn[i]) - kLowest)];
-      else return mn[i] <= mx[i] && table.anyVisible(double(mn[i]), double(mx[i]));
-    };
+    std::uint8_t* out = distance_.data();
     forChunks(n / std::max<std::size_t>(layer, 1), pool, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b * layer; i < e * layer; ++i)
-        distance_[i] = !skipEmpty || visible(i) ? 0 : kFar;
+      if constexpr (kTabled) {
+        markShown(mn, mx, leastShownMax.data() - kLowest, out, b * layer, e * layer);
+      } else {
+        for (std::size_t i = b * layer; i < e * layer; ++i)
+          out[i] = mn[i] <= mx[i] && table.anyVisible(double(mn[i]), double(mx[i])) ? 0 : kFar;
+      }
     });
   });
-  if (skipEmpty) leapDistance(distance_.data(), count(), pool);
+  leapDistance(distance_.data(), count(), pool);
   findVisibleBox();
 }
 
