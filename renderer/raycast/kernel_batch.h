@@ -201,6 +201,23 @@ template <typename T>
                lerp8(lerp8(c0, c1, f[0]), lerp8(e0, e1, f[0]), f[1]), f[2]);
 }
 
+#ifdef PVR_HAVE_PREINT_LANES
+// The colours of eight segments as Quads (kernel_batch_over.h), lanes
+// outside `keep` transparent: r, g, b, a of lanes j and j + 4 side by side.
+[[gnu::always_inline]] inline Quads segmentQuads(const preint::Segments8& seg, __mmask8 keep) {
+  const __m256 r = _mm512_maskz_cvtpd_ps(keep, seg.r), g = _mm512_maskz_cvtpd_ps(keep, seg.g);
+  const __m256 b = _mm512_maskz_cvtpd_ps(keep, seg.b), a = _mm512_maskz_cvtpd_ps(keep, seg.a);
+  const __m256 rgLow = _mm256_unpacklo_ps(r, g), baLow = _mm256_unpacklo_ps(b, a);  // lanes 0 1 | 4 5
+  const __m256 rgHigh = _mm256_unpackhi_ps(r, g), baHigh = _mm256_unpackhi_ps(b, a);  // lanes 2 3 | 6 7
+  Quads q;
+  q.q[0] = _mm256_shuffle_ps(rgLow, baLow, 0x44);
+  q.q[1] = _mm256_shuffle_ps(rgLow, baLow, 0xEE);
+  q.q[2] = _mm256_shuffle_ps(rgHigh, baHigh, 0x44);
+  q.q[3] = _mm256_shuffle_ps(rgHigh, baHigh, 0xEE);
+  return q;
+}
+#endif
+
 // Pre-integrated segments [s, s + 1) for s in [start, exit), eight at a
 // time: the scalars at s + 2 .. s + 9 in one batch, the eight corrected
 // nodes s + 1 .. s + 8 (curvedNode()) in another, the eight segments
@@ -305,6 +322,21 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     const preint::Ends8 backs = preint::endsAt(p.preint, node);
     const preint::Ends8 fronts = preint::fronts(before, backs);
     const preint::Segments8 seg = preint::segments<kShaded>(fronts, backs, p.stepLength);
+    if (!kShaded && !seg.opaque) {
+      // Unlit and with no opaque segment (those take the loop below), the
+      // eight segments are composited with each other as plain samples are
+      // (kernel_batch_over.h), then into the ray: one link of the "over"
+      // chain per batch instead of eight.
+      __m256d gathered = _mm256_setr_pd(acc.r, acc.g, acc.b, acc.a);
+      gathered = addBehind4(gathered, overQuads(segmentQuads(seg, __mmask8(valid))));
+      alignas(32) double out[4];
+      _mm256_store_pd(out, gathered);
+      acc = {out[0], out[1], out[2], out[3]};
+      before = backs;
+      advance(s, count);
+      if (acc.a >= p.earlyTermination) return true;
+      continue;
+    }
     alignas(32) float r[8], g[8], b[8], a[8], centre[8], spread[8];
     _mm256_store_ps(r, _mm512_maskz_cvtpd_ps(preint::kAll, seg.r));
     _mm256_store_ps(g, _mm512_maskz_cvtpd_ps(preint::kAll, seg.g));
