@@ -251,8 +251,8 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   // samples at s and s + 1, lane 7 of carriedLo and carriedHi the range of
   // the cell of s + 1 (aroundRange()).
   __m256 carried, carriedLo, carriedHi;
-  // Lanes 6 + j of the window before `x` followed by x, j = 0..7 (kShift 8
-  // bytes) or 7 + j (12 bytes): a shift across the two vectors.
+  // Lane j of the result: lane 6 + j (`bytes` 8) or 7 + j (`bytes` 12) of
+  // `window` followed by `x`, a shift across the two vectors.
   auto shifted = [](__m256 window, __m256 x, auto bytes) __attribute__((always_inline)) {
     const __m256i t = _mm256_castps_si256(_mm256_permute2f128_ps(window, x, 0x21));
     return _mm256_castsi256_ps(_mm256_alignr_epi8(_mm256_castps_si256(x), t, decltype(bytes)::value));
