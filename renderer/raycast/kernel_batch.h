@@ -201,6 +201,23 @@ template <typename T>
                lerp8(lerp8(c0, c1, f[0]), lerp8(e0, e1, f[0]), f[1]), f[2]);
 }
 
+#ifdef PVR_HAVE_PREINT_LANES
+// The colours of eight segments as Quads (kernel_batch_over.h), lanes
+// outside `keep` transparent: r, g, b, a of lanes j and j + 4 side by side.
+[[gnu::always_inline]] inline Quads segmentQuads(const preint::Segments8& seg, __mmask8 keep) {
+  const __m256 r = _mm512_maskz_cvtpd_ps(keep, seg.r), g = _mm512_maskz_cvtpd_ps(keep, seg.g);
+  const __m256 b = _mm512_maskz_cvtpd_ps(keep, seg.b), a = _mm512_maskz_cvtpd_ps(keep, seg.a);
+  const __m256 rgLow = _mm256_unpacklo_ps(r, g), baLow = _mm256_unpacklo_ps(b, a);  // lanes 0 1 | 4 5
+  const __m256 rgHigh = _mm256_unpackhi_ps(r, g), baHigh = _mm256_unpackhi_ps(b, a);  // lanes 2 3 | 6 7
+  Quads q;
+  q.q[0] = _mm256_shuffle_ps(rgLow, baLow, 0x44);
+  q.q[1] = _mm256_shuffle_ps(rgLow, baLow, 0xEE);
+  q.q[2] = _mm256_shuffle_ps(rgHigh, baHigh, 0x44);
+  q.q[3] = _mm256_shuffle_ps(rgHigh, baHigh, 0xEE);
+  return q;
+}
+#endif
+
 // Pre-integrated segments [s, s + 1) for s in [start, exit), eight at a
 // time: the scalars at s + 2 .. s + 9 in one batch, the eight corrected
 // nodes s + 1 .. s + 8 (curvedNode()) in another, the eight segments
@@ -228,8 +245,20 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   auto finite8 = [&](__m256 x) __attribute__((always_inline)) {
     return _mm256_cmp_ps(_mm256_andnot_ps(signBit, x), finiteMax, _CMP_LE_OQ);
   };
-  // raw[j]: the sample at s + j, j in [0, 10); lo[j], hi[j] its cell's range.
-  alignas(32) float raw[16], lo[16], hi[16];
+  // The window of samples in registers (through memory, the loads of a
+  // batch's samples shifted by one and two lanes straddled the store just
+  // made and stalled store forwarding): lanes 6 and 7 of `carried` hold the
+  // samples at s and s + 1, lane 7 of carriedLo and carriedHi the range of
+  // the cell of s + 1 (aroundRange()).
+  __m256 carried, carriedLo, carriedHi;
+  // Lane j of the result: lane 6 + j (`bytes` 8) or 7 + j (`bytes` 12) of
+  // `window` followed by `x`, a shift across the two vectors.
+  auto shifted = [](__m256 window, __m256 x, auto bytes) __attribute__((always_inline)) {
+    const __m256i t = _mm256_castps_si256(_mm256_permute2f128_ps(window, x, 0x21));
+    return _mm256_castsi256_ps(_mm256_alignr_epi8(_mm256_castps_si256(x), t, decltype(bytes)::value));
+  };
+  using kOne = std::integral_constant<int, 12>;  // one sample before x's lanes
+  using kTwo = std::integral_constant<int, 8>;   // two samples before
   // The window at `start` (preintWindow()): the samples at start - 1 ..
   // start + 6 in one batch; the front node at `start`, and the sample at
   // start + 1 and its range for the first batch's first node.
@@ -244,18 +273,16 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     frontScalar = curvedNode<T>(first[0], first[1], first[2], firstLo[1], firstHi[1]);
     if (!finite<T>(frontScalar)) frontScalar = 0;  // looked up as 0 (segmentEnd())
     frontEnd = preint::endAt(p.preint, frontScalar);
-    raw[0] = first[1];
-    raw[1] = first[2];
-    lo[1] = firstLo[2];
-    hi[1] = firstHi[2];
+    carried = _mm256_set_ps(first[2], first[1], 0, 0, 0, 0, 0, 0);
+    carriedLo = _mm256_set1_ps(firstLo[2]);
+    carriedHi = _mm256_set1_ps(firstHi[2]);
   }
   // On to the next batch, `count` segments done: the two samples before
   // its first node carried over.
-  auto advance = [&](std::int64_t s, int count) __attribute__((always_inline)) {
-    raw[0] = raw[8];
-    raw[1] = raw[9];
-    lo[1] = lo[9];
-    hi[1] = hi[9];
+  auto advance = [&](std::int64_t s, int count, __m256 x, __m256 xLo, __m256 xHi) __attribute__((always_inline)) {
+    carried = x;
+    carriedLo = xLo;
+    carriedHi = xHi;
     samples += std::uint64_t(count);
     start = s + count;
   };
@@ -267,14 +294,14 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   bool frontStale = false;
 #endif
   for (std::int64_t s = start; s + kFullBatchesOnly < exit; s += 8) {
+    // The samples at s + 2 .. s + 9 (after), and at s .. s + 7 and s + 1 .. s + 8.
     __m256 lo8, hi8;
-    _mm256_storeu_ps(raw + 2, aroundBatch(v, p, o, d, s + 2, lo8, hi8));
-    _mm256_storeu_ps(lo + 2, lo8);
-    _mm256_storeu_ps(hi + 2, hi8);
-    const __m256 before8 = _mm256_loadu_ps(raw), at = _mm256_loadu_ps(raw + 1), after = _mm256_loadu_ps(raw + 2);
+    const __m256 after = aroundBatch(v, p, o, d, s + 2, lo8, hi8);
+    const __m256 before8 = shifted(carried, after, kTwo{}), at = shifted(carried, after, kOne{});
     const __m256 bend = _mm256_add_ps(_mm256_sub_ps(before8, _mm256_add_ps(at, at)), after);
     __m256 node = _mm256_sub_ps(at, _mm256_mul_ps(bend, _mm256_set1_ps(1.0f / 12.0f)));
-    const __m256 clamped = _mm256_min_ps(_mm256_max_ps(node, _mm256_loadu_ps(lo + 1)), _mm256_loadu_ps(hi + 1));
+    const __m256 clamped = _mm256_min_ps(_mm256_max_ps(node, shifted(carriedLo, lo8, kOne{})),
+                                         shifted(carriedHi, hi8, kOne{}));
     if constexpr (std::is_floating_point_v<T>) {
       node = _mm256_blendv_ps(at, clamped, finite8(node));
     } else {
@@ -296,7 +323,7 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     if (preint::allEmpty(p.preint, node, frontNode)) {
       frontStale = true;
       frontNode = nextFront;
-      advance(s, count);
+      advance(s, count, after, lo8, hi8);
       continue;
     }
     if (frontStale) before = preint::broadcast(preint::endAt(p.preint, frontNode));
@@ -305,6 +332,21 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     const preint::Ends8 backs = preint::endsAt(p.preint, node);
     const preint::Ends8 fronts = preint::fronts(before, backs);
     const preint::Segments8 seg = preint::segments<kShaded>(fronts, backs, p.stepLength);
+    if (!kShaded && !seg.opaque) {
+      // Unlit and with no opaque segment (those take the loop below), the
+      // eight segments are composited with each other as plain samples are
+      // (kernel_batch_over.h), then into the ray: one link of the "over"
+      // chain per batch instead of eight.
+      __m256d gathered = _mm256_setr_pd(acc.r, acc.g, acc.b, acc.a);
+      gathered = addBehind4(gathered, overQuads(segmentQuads(seg, __mmask8(valid))));
+      alignas(32) double out[4];
+      _mm256_store_pd(out, gathered);
+      acc = {out[0], out[1], out[2], out[3]};
+      before = backs;
+      advance(s, count, after, lo8, hi8);
+      if (acc.a >= p.earlyTermination) return true;
+      continue;
+    }
     alignas(32) float r[8], g[8], b[8], a[8], centre[8], spread[8];
     _mm256_store_ps(r, _mm512_maskz_cvtpd_ps(preint::kAll, seg.r));
     _mm256_store_ps(g, _mm512_maskz_cvtpd_ps(preint::kAll, seg.g));
@@ -336,8 +378,10 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
       acc.addBehind(c);
     }
 #else
-    alignas(32) float back[8];
+    alignas(32) float back[8], raw[9];
     _mm256_store_ps(back, node);
+    _mm256_storeu_ps(raw, before8);
+    raw[8] = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(at, _mm256_set1_epi32(7)));
     for (int lane = 0; lane < 8; ++lane) {
       const preint::End backEnd = segmentEnd<T>(p, back[lane]);
       float centre = 0.5f, spread = 0.0f;
@@ -352,7 +396,7 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
       acc.addBehind(c);
     }
 #endif
-    advance(s, count);
+    advance(s, count, after, lo8, hi8);
     if (acc.a >= p.earlyTermination) return true;
   }
   return false;

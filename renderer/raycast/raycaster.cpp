@@ -131,7 +131,10 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   setBrick(p, brick_, macrocells_);
   if (region_) ownRegion(p, grid, *region_);
   const bool levelled = !levelTables_.empty();
-  const double step = levelled ? fineStep(options.step) : options.step;  // the rays' sample spacing
+  // The rays' sample spacing.
+  const double step = levelled          ? fineStep(options.step)
+                      : preintegrated_ ? preint::sampleSpacing(options.step, grid.minSpacing())
+                                       : options.step;
   setTables(p, table_, preintegrated_.get(), step);
   const std::vector<float> specular = specularTable(options.shading.shininess);
   setOptions(p, options, specular.data());
