@@ -5,9 +5,9 @@
 // Lit one at a time, a sample's interior gradient read its 32 nodes with
 // 32 scalar loads and conversions, and its normalise and specular look-up
 // ran in scalar arithmetic: most of a shaded frame. Here each lane reads
-// the 32 nodes as 16 pairs of neighbours along x (one load each, as the
-// reconstruction does, batch_loads.h), and every step after the loads is
-// one vector instruction for all eight samples. Lanes outside the
+// the 32 nodes in 12 loads (four rows of four nodes along x, eight pairs,
+// batch_loads.h), and every step after the loads is one vector
+// instruction for all eight samples. Lanes outside the
 // interior form (near the domain's faces or the stored box's) take the
 // scalar kernel::gradient(), so whole volume and bricks still read the
 // same nodes for the same sample (kernel::interiorGradient()).
@@ -78,9 +78,12 @@ template <typename T>
     // differences reuse.
     __m256 xm[4], x0[4], x1[4], x2[4];
     for (int r = 0; r < 4; ++r) {
-      const std::int64_t row = (r & 1) * sy + (r >> 1) * sz;
-      loadPairs8(v, index, row - 1, xm[r], x0[r]);
-      loadPairs8(v, index, row + 1, x1[r], x2[r]);
+      __m256 q[4];
+      loadQuads8(v, index, (r & 1) * sy + (r >> 1) * sz - 1, q);
+      xm[r] = q[0];
+      x0[r] = q[1];
+      x1[r] = q[2];
+      x2[r] = q[3];
     }
     // Nodes y - 1 and y + 2 at dz = 0, 1, and z - 1 and z + 2 at dy = 0, 1
     // (pairs: dx = 0 and 1).
