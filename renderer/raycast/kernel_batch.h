@@ -100,6 +100,7 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
     Quads c = classifyQuads(p.table, entry, _mm256_sub_ps(x, _mm256_cvtepi32_ps(entry)));
     if constexpr (std::is_floating_point_v<T>) keepQuads(c, finite);
     if constexpr (kShaded) {
+      // Light the visible samples, all eight lanes at once (shade_lanes.h).
       const __m256 u[3] = {u0, u1, u2};
       shadeQuads(v, p, ray, u, c);
     }
