@@ -55,7 +55,6 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
   const __m256i entryLast = _mm256_set1_epi32(p.tableEntries - 2);
   const __m256 clearBelow = _mm256_set1_ps(p.clearBelow), clearAbove = _mm256_set1_ps(p.clearAbove);
   const std::int64_t sy = p.strideY, sz = p.strideZ;
-  const InteriorBox8 interiorBox(p);  // used when shaded
   __m256d gathered = _mm256_setr_pd(acc.r, acc.g, acc.b, acc.a);
   bool terminated = false;
 
@@ -75,25 +74,12 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
                        _mm256_add_epi32(_mm256_add_epi32(i, base),
                                         _mm256_add_epi32(_mm256_mullo_epi32(j, strideY),
                                                          _mm256_mullo_epi32(kk, strideZ))));
-    // Trilinear reconstruction. Shaded, a batch whose cells are all
-    // interior reads the gradient's four rows along x (four voxels, one
-    // load per lane), which hold the reconstruction's pairs: 12 loads a
-    // lit lane in all, not 16.
+    // Trilinear reconstruction.
     __m256 a0, a1, b0, b1, c0, c1, e0, e1;
-    const __m256 u[3] = {u0, u1, u2};
-    __m256 rows[4][4];
-    bool interior = false;
-    if constexpr (kShaded) interior = interiorBox.holds(u);
-    if (interior) {
-      loadGradientRows8(v, p, index, rows);
-      a0 = rows[0][1], a1 = rows[0][2], b0 = rows[1][1], b1 = rows[1][2];
-      c0 = rows[2][1], c1 = rows[2][2], e0 = rows[3][1], e1 = rows[3][2];
-    } else {
-      loadPairs8(v, index, 0, a0, a1);
-      loadPairs8(v, index, sy, b0, b1);
-      loadPairs8(v, index, sz, c0, c1);
-      loadPairs8(v, index, sy + sz, e0, e1);
-    }
+    loadPairs8(v, index, 0, a0, a1);
+    loadPairs8(v, index, sy, b0, b1);
+    loadPairs8(v, index, sz, c0, c1);
+    loadPairs8(v, index, sy + sz, e0, e1);
     const __m256 value = lerp8(lerp8(lerp8(a0, a1, fx), lerp8(b0, b1, fx), fy),
                                lerp8(lerp8(c0, c1, fx), lerp8(e0, e1, fx), fy), fz);
     samples += 8;
@@ -115,12 +101,8 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
     if constexpr (std::is_floating_point_v<T>) keepQuads(c, finite);
     if constexpr (kShaded) {
       // Light the visible samples, all eight lanes at once (shade_lanes.h).
-      if (interior) {
-        const __m256 f[3] = {fx, fy, fz};
-        shadeInteriorQuads(v, p, ray, index, f, rows, c);
-      } else {
-        shadeQuads(v, p, ray, u, c);
-      }
+      const __m256 u[3] = {u0, u1, u2};
+      shadeQuads(v, p, ray, u, c);
     }
     // Composite the batch, then the batch into the ray.
     gathered = addBehind4(gathered, overQuads(c));

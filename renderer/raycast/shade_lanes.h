@@ -17,7 +17,6 @@
 
 #include <immintrin.h>
 
-#include <algorithm>
 #include <cfloat>
 #include <cstdint>
 
@@ -47,86 +46,6 @@ namespace pvr::core::kernel {
   return inside;
 }
 
-// Where every lane of a batch is interior (interiorLanes8()) with its
-// cell int(u) equal to runBatched's (clamped into the owned cells): a box
-// in index space, lo <= u, u <= hiClosed and u < hiOpen per axis. The
-// conditions on int(u) are conditions on u (u >= 1), and a ray's
-// positions are monotone in the sample, so a batch is inside when all of
-// its lanes test inside.
-struct InteriorBox8 {
-  __m256 lo[3], hiClosed[3], hiOpen[3];
-  explicit InteriorBox8(const KernelParams& p) {
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = _mm256_set1_ps(float(std::max({1, p.storedCellLo[a] + 1, p.ownCellLo[a]})));
-      hiClosed[a] = _mm256_set1_ps(p.domainMax[a] - 1.0f);
-      hiOpen[a] = _mm256_set1_ps(float(std::min(p.storedCellHi[a], p.ownCellHi[a] + 1)));
-    }
-  }
-  // All eight lanes of positions u inside (a NaN is not).
-  [[gnu::always_inline]] bool holds(const __m256 u[3]) const {
-    __m256 in = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
-    for (int a = 0; a < 3; ++a)
-      in = _mm256_and_ps(in, _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(u[a], lo[a], _CMP_GE_OQ),
-                                                         _mm256_cmp_ps(u[a], hiClosed[a], _CMP_LE_OQ)),
-                                           _mm256_cmp_ps(u[a], hiOpen[a], _CMP_LT_OQ)));
-    return _mm256_movemask_ps(in) == 0xFF;
-  }
-};
-
-// The four rows along x of a lane's interior gradient, at (dy, dz) = (0,0),
-// (1,0), (0,1), (1,1) around its cell (voxel index[j], KernelParams::base
-// included): rows[r][n] holds node x - 1 + n, so rows[r][1] and rows[r][2]
-// are the cell's own corners, the trilinear reconstruction's pairs
-// (runBatched reads them here once for both).
-template <typename T>
-[[gnu::always_inline]] inline void loadGradientRows8(const T* v, const KernelParams& p, const std::int32_t* index,
-                                                     __m256 rows[4][4]) {
-  for (int r = 0; r < 4; ++r) loadQuads8(v, index, (r & 1) * p.strideY + (r >> 1) * p.strideZ - 1, rows[r]);
-}
-
-// kernel::interiorGradient() of eight lanes whose cells (voxel index[j])
-// are interior (interiorLanes8()), fractions f, rows from
-// loadGradientRows8(): the other 16 nodes read here, in world units.
-template <typename T>
-[[gnu::always_inline]] inline void gradientFromRows8(const T* v, const KernelParams& p, const std::int32_t* index,
-                                                     const __m256 f[3], const __m256 rows[4][4], __m256 g[3]) {
-  const __m256 fx = f[0], fy = f[1], fz = f[2];
-  const std::int64_t sy = p.strideY, sz = p.strideZ;
-  // Nodes y - 1 and y + 2 at dz = 0, 1, and z - 1 and z + 2 at dy = 0, 1
-  // (pairs: dx = 0 and 1).
-  __m256 ym[2][2], y2[2][2], zm[2][2], z2[2][2];
-  for (int h = 0; h < 2; ++h) {
-    loadPairs8(v, index, -sy + h * sz, ym[h][0], ym[h][1]);
-    loadPairs8(v, index, 2 * sy + h * sz, y2[h][0], y2[h][1]);
-    loadPairs8(v, index, -sz + h * sy, zm[h][0], zm[h][1]);
-    loadPairs8(v, index, 2 * sz + h * sy, z2[h][0], z2[h][1]);
-  }
-  // The cell's corner (dx, dy, dz), which the y and z differences reuse.
-  auto corner = [&](int dx, int dy, int dz) __attribute__((always_inline)) {
-    return rows[dy + 2 * dz][1 + dx];
-  };
-  // (1 - f) (after - before) + f (far - near): a central difference at
-  // the two nodes either side, interpolated (interiorGradient()).
-  auto difference = [](__m256 f, __m256 before, __m256 near, __m256 after, __m256 far)
-                        __attribute__((always_inline)) {
-    return _mm256_fmadd_ps(f, _mm256_sub_ps(far, near),
-                           _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(1.0f), f), _mm256_sub_ps(after, before)));
-  };
-  auto bilinear = [](__m256 w1, __m256 w2, __m256 a00, __m256 a10, __m256 a01, __m256 a11)
-                      __attribute__((always_inline)) { return lerp8(lerp8(a00, a10, w1), lerp8(a01, a11, w1), w2); };
-  __m256 dX[4], dY[4], dZ[4];
-  for (int r = 0; r < 4; ++r) dX[r] = difference(fx, rows[r][0], rows[r][1], rows[r][2], rows[r][3]);
-  for (int dz = 0; dz < 2; ++dz)
-    for (int dx = 0; dx < 2; ++dx)
-      dY[dx + 2 * dz] = difference(fy, ym[dz][dx], corner(dx, 0, dz), corner(dx, 1, dz), y2[dz][dx]);
-  for (int dy = 0; dy < 2; ++dy)
-    for (int dx = 0; dx < 2; ++dx)
-      dZ[dx + 2 * dy] = difference(fz, zm[dy][dx], corner(dx, dy, 0), corner(dx, dy, 1), z2[dy][dx]);
-  g[0] = _mm256_mul_ps(bilinear(fy, fz, dX[0], dX[1], dX[2], dX[3]), _mm256_set1_ps(0.5f * p.invSpacing[0]));
-  g[1] = _mm256_mul_ps(bilinear(fx, fz, dY[0], dY[1], dY[2], dY[3]), _mm256_set1_ps(0.5f * p.invSpacing[1]));
-  g[2] = _mm256_mul_ps(bilinear(fx, fy, dZ[0], dZ[1], dZ[2], dZ[3]), _mm256_set1_ps(0.5f * p.invSpacing[2]));
-}
-
 // The gradients at the eight positions u (index space) of the lanes in
 // `wanted` (bit j: lane j), as kernel::gradient() computes them, up to
 // rounding; the other lanes' are unspecified (finite or not). g in world
@@ -150,12 +69,55 @@ template <typename T>
         _mm256_permutevar8x32_epi32(index0, _mm256_set1_epi32(__builtin_ctz(interior)));
     alignas(32) std::int32_t index[8];
     _mm256_store_si256(reinterpret_cast<__m256i*>(index), _mm256_blendv_epi8(firstLane, index0, inLane));
-    const __m256 f[3] = {_mm256_sub_ps(u[0], _mm256_cvtepi32_ps(cell[0])),
-                         _mm256_sub_ps(u[1], _mm256_cvtepi32_ps(cell[1])),
-                         _mm256_sub_ps(u[2], _mm256_cvtepi32_ps(cell[2]))};
-    __m256 rows[4][4];
-    loadGradientRows8(v, p, index, rows);
-    gradientFromRows8(v, p, index, f, rows, g);
+    const __m256 fx = _mm256_sub_ps(u[0], _mm256_cvtepi32_ps(cell[0]));
+    const __m256 fy = _mm256_sub_ps(u[1], _mm256_cvtepi32_ps(cell[1]));
+    const __m256 fz = _mm256_sub_ps(u[2], _mm256_cvtepi32_ps(cell[2]));
+    const std::int64_t sy = p.strideY, sz = p.strideZ;
+    // Rows along x at (dy, dz) = (0,0), (1,0), (0,1), (1,1): nodes x - 1 ..
+    // x + 2; x0 and x1 are the cell's own corners, which the y and z
+    // differences reuse.
+    __m256 xm[4], x0[4], x1[4], x2[4];
+    for (int r = 0; r < 4; ++r) {
+      __m256 q[4];
+      loadQuads8(v, index, (r & 1) * sy + (r >> 1) * sz - 1, q);
+      xm[r] = q[0];
+      x0[r] = q[1];
+      x1[r] = q[2];
+      x2[r] = q[3];
+    }
+    // Nodes y - 1 and y + 2 at dz = 0, 1, and z - 1 and z + 2 at dy = 0, 1
+    // (pairs: dx = 0 and 1).
+    __m256 ym[2][2], y2[2][2], zm[2][2], z2[2][2];
+    for (int h = 0; h < 2; ++h) {
+      loadPairs8(v, index, -sy + h * sz, ym[h][0], ym[h][1]);
+      loadPairs8(v, index, 2 * sy + h * sz, y2[h][0], y2[h][1]);
+      loadPairs8(v, index, -sz + h * sy, zm[h][0], zm[h][1]);
+      loadPairs8(v, index, 2 * sz + h * sy, z2[h][0], z2[h][1]);
+    }
+    // The cell's corner (dx, dy, dz).
+    auto corner = [&](int dx, int dy, int dz) __attribute__((always_inline)) {
+      return dx ? x1[dy + 2 * dz] : x0[dy + 2 * dz];
+    };
+    // (1 - f) (after - before) + f (far - near): a central difference at
+    // the two nodes either side, interpolated (interiorGradient()).
+    auto difference = [](__m256 f, __m256 before, __m256 near, __m256 after, __m256 far)
+                          __attribute__((always_inline)) {
+      return _mm256_fmadd_ps(f, _mm256_sub_ps(far, near),
+                             _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(1.0f), f), _mm256_sub_ps(after, before)));
+    };
+    auto bilinear = [](__m256 w1, __m256 w2, __m256 a00, __m256 a10, __m256 a01, __m256 a11)
+                        __attribute__((always_inline)) { return lerp8(lerp8(a00, a10, w1), lerp8(a01, a11, w1), w2); };
+    __m256 dX[4], dY[4], dZ[4];
+    for (int r = 0; r < 4; ++r) dX[r] = difference(fx, xm[r], x0[r], x1[r], x2[r]);
+    for (int dz = 0; dz < 2; ++dz)
+      for (int dx = 0; dx < 2; ++dx)
+        dY[dx + 2 * dz] = difference(fy, ym[dz][dx], corner(dx, 0, dz), corner(dx, 1, dz), y2[dz][dx]);
+    for (int dy = 0; dy < 2; ++dy)
+      for (int dx = 0; dx < 2; ++dx)
+        dZ[dx + 2 * dy] = difference(fz, zm[dy][dx], corner(dx, dy, 0), corner(dx, dy, 1), z2[dy][dx]);
+    g[0] = _mm256_mul_ps(bilinear(fy, fz, dX[0], dX[1], dX[2], dX[3]), _mm256_set1_ps(0.5f * p.invSpacing[0]));
+    g[1] = _mm256_mul_ps(bilinear(fx, fz, dY[0], dY[1], dY[2], dY[3]), _mm256_set1_ps(0.5f * p.invSpacing[1]));
+    g[2] = _mm256_mul_ps(bilinear(fx, fy, dZ[0], dZ[1], dZ[2], dZ[3]), _mm256_set1_ps(0.5f * p.invSpacing[2]));
   } else {
     g[0] = g[1] = g[2] = _mm256_setzero_ps();
   }
@@ -203,11 +165,17 @@ template <typename T>
   return _mm256_shuffle_ps(a01, a23, _MM_SHUFFLE(2, 0, 2, 0));  // a0 a1 a2 a3 | a4 a5 a6 a7
 }
 
-// Blinn-Phong of the lanes in `visible` (their colours c, gradients g),
-// two-sided, as kernel::shade(); the other lanes are left as they are.
-[[gnu::always_inline]] inline void lightQuads(const KernelParams& p, const RaySetup& ray, const __m256 g[3],
-                                              __m256 visible, Quads& c) {
-  // A zero or non-finite gradient is lit head-on.
+// The batch's samples at positions u, colours c, lit as kernel::shade()
+// lights each: those with opacity > 0; the others are left as they are.
+template <typename T>
+[[gnu::always_inline]] inline void shadeQuads(const T* v, const KernelParams& p, const RaySetup& ray,
+                                              const __m256 u[3], Quads& c) {
+  const __m256 visible = _mm256_cmp_ps(alphaLanes(c), _mm256_setzero_ps(), _CMP_GT_OQ);
+  const unsigned wanted = unsigned(_mm256_movemask_ps(visible));
+  if (!wanted) return;
+  __m256 g[3];
+  gradient8(v, p, u, wanted, g);
+  // Blinn-Phong, two-sided; a zero or non-finite gradient is lit head-on.
   const __m256 gg = _mm256_fmadd_ps(g[2], g[2], _mm256_fmadd_ps(g[1], g[1], _mm256_mul_ps(g[0], g[0])));
   const __m256 lighted = _mm256_and_ps(_mm256_cmp_ps(gg, _mm256_set1_ps(1e-20f), _CMP_GT_OQ),
                                        _mm256_cmp_ps(gg, _mm256_set1_ps(FLT_MAX), _CMP_LE_OQ));
@@ -241,33 +209,6 @@ template <typename T>
     const __m256 a = _mm256_blend_ps(_mm256_permutevar8x32_ps(add, pick), _mm256_setzero_ps(), 0x88);
     c.q[j] = _mm256_fmadd_ps(a, _mm256_permute_ps(c.q[j], 0xFF), _mm256_mul_ps(c.q[j], s));
   }
-}
-
-// The batch's samples at positions u, colours c, lit as kernel::shade()
-// lights each: those with opacity > 0; the others are left as they are.
-template <typename T>
-[[gnu::always_inline]] inline void shadeQuads(const T* v, const KernelParams& p, const RaySetup& ray,
-                                              const __m256 u[3], Quads& c) {
-  const __m256 visible = _mm256_cmp_ps(alphaLanes(c), _mm256_setzero_ps(), _CMP_GT_OQ);
-  const unsigned wanted = unsigned(_mm256_movemask_ps(visible));
-  if (!wanted) return;
-  __m256 g[3];
-  gradient8(v, p, u, wanted, g);
-  lightQuads(p, ray, g, visible, c);
-}
-
-// shadeQuads() for a batch whose eight cells are all interior (voxel
-// index[j], fractions f) and whose gradient rows were read already
-// (loadGradientRows8()).
-template <typename T>
-[[gnu::always_inline]] inline void shadeInteriorQuads(const T* v, const KernelParams& p, const RaySetup& ray,
-                                                      const std::int32_t* index, const __m256 f[3],
-                                                      const __m256 rows[4][4], Quads& c) {
-  const __m256 visible = _mm256_cmp_ps(alphaLanes(c), _mm256_setzero_ps(), _CMP_GT_OQ);
-  if (!_mm256_movemask_ps(visible)) return;
-  __m256 g[3];
-  gradientFromRows8(v, p, index, f, rows, g);
-  lightQuads(p, ray, g, visible, c);
 }
 
 }  // namespace pvr::core::kernel
