@@ -277,23 +277,32 @@ template <typename T>
   return true;
 }
 
+// The world-space gradient at a sample by central differences of the
+// reconstructed field, one voxel either side, clamped into the domain (one
+// sided at its faces). interiorGradient() where it applies.
+template <typename T>
+[[gnu::always_inline]] inline void gradient(const T* v, const KernelParams& p, float u0, float u1, float u2,
+                                            float g[3]) {
+  if (interiorGradient(v, p, u0, u1, u2, g)) return;
+  const float u[3] = {u0, u1, u2};
+  for (int a = 0; a < 3; ++a) {
+    float up[3] = {u0, u1, u2}, dn[3] = {u0, u1, u2};
+    up[a] = std::min(u[a] + 1.0f, p.domainMax[a]);
+    dn[a] = std::max(u[a] - 1.0f, 0.0f);
+    const float dist = up[a] - dn[a];
+    const float diff = around(v, p, up[0], up[1], up[2]) - around(v, p, dn[0], dn[1], dn[2]);
+    g[a] = dist > 0 ? diff / dist * p.invSpacing[a] : 0.0f;
+  }
+}
+
 // Blinn-Phong with a central-difference gradient, two-sided. A zero or
 // undefined gradient (homogeneous or non-finite data) is lit head-on.
+// (shade_lanes.h lights eight samples of a batch alike.)
 template <typename T>
 [[gnu::always_inline]] inline Rgba shade(const T* v, const KernelParams& p, const RaySetup& ray, float u0, float u1,
                   float u2, Rgba c) {
   float g[3];
-  const float u[3] = {u0, u1, u2};
-  if (!interiorGradient(v, p, u0, u1, u2, g)) {
-    for (int a = 0; a < 3; ++a) {
-      float up[3] = {u0, u1, u2}, dn[3] = {u0, u1, u2};
-      up[a] = std::min(u[a] + 1.0f, p.domainMax[a]);
-      dn[a] = std::max(u[a] - 1.0f, 0.0f);
-      const float dist = up[a] - dn[a];
-      const float diff = around(v, p, up[0], up[1], up[2]) - around(v, p, dn[0], dn[1], dn[2]);
-      g[a] = dist > 0 ? diff / dist * p.invSpacing[a] : 0.0f;
-    }
-  }
+  gradient(v, p, u0, u1, u2, g);
   const float gg = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
   float lit = p.ambient + p.diffuse;
   float spec = 0;

@@ -23,47 +23,10 @@
 #include "preint_lanes.h"
 #include "preint_lighting.h"
 #include "kernel_batch_over.h"
+#include "batch_loads.h"
+#include "shade_lanes.h"
 
 namespace pvr::core::kernel {
-
-inline __m256i clampCells8(__m256 u, int lo, int hi) {
-  return _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(u), _mm256_set1_epi32(lo)),
-                          _mm256_set1_epi32(hi));
-}
-
-inline __m256 lerp8(__m256 a, __m256 b, __m256 w) { return _mm256_fmadd_ps(w, _mm256_sub_ps(b, a), a); }
-
-// Voxels index[j] + offset and index[j] + offset + 1 of eight lanes.
-template <typename T>
-[[gnu::always_inline]] inline void loadPairs8(const T* v, const std::int32_t* index, std::int64_t offset,
-                                              __m256& lo, __m256& hi) {
-  const T* b = v + offset;
-  if constexpr (std::is_floating_point_v<T>) {
-    lo = _mm256_setr_ps(b[index[0]], b[index[1]], b[index[2]], b[index[3]], b[index[4]], b[index[5]],
-                        b[index[6]], b[index[7]]);
-    hi = _mm256_setr_ps(b[index[0] + 1], b[index[1] + 1], b[index[2] + 1], b[index[3] + 1],
-                        b[index[4] + 1], b[index[5] + 1], b[index[6] + 1], b[index[7] + 1]);
-  } else {
-    // One load of twice the scalar's width holds both neighbours.
-    using Pair = std::conditional_t<sizeof(T) == 1, std::uint16_t, std::uint32_t>;
-    auto pair = [b](std::int32_t at) __attribute__((always_inline)) {
-      Pair w;
-      std::memcpy(&w, b + at, sizeof w);
-      return std::int32_t(w);
-    };
-    const __m256i words = _mm256_setr_epi32(pair(index[0]), pair(index[1]), pair(index[2]), pair(index[3]),
-                                            pair(index[4]), pair(index[5]), pair(index[6]), pair(index[7]));
-    constexpr int kBits = 8 * sizeof(T);
-    if constexpr (std::is_signed_v<T>) {
-      lo = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(words, 32 - kBits), 32 - kBits));
-      hi = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(words, 32 - 2 * kBits), 32 - kBits));
-    } else {
-      const __m256i mask = _mm256_set1_epi32((1 << kBits) - 1);
-      lo = _mm256_cvtepi32_ps(_mm256_and_si256(words, mask));
-      hi = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(words, kBits), mask));
-    }
-  }
-}
 
 // Samples [start, exit) of a visible run, eight at a time while eight
 // remain; `start` advances past what was done, the caller takes the rest
@@ -137,17 +100,9 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
     Quads c = classifyQuads(p.table, entry, _mm256_sub_ps(x, _mm256_cvtepi32_ps(entry)));
     if constexpr (std::is_floating_point_v<T>) keepQuads(c, finite);
     if constexpr (kShaded) {
-      // Light each visible sample; quad j holds samples j and j + 4.
-      alignas(32) Rgba lit[8];
-      for (int q = 0; q < 4; ++q) _mm256_store_ps(&lit[2 * q].r, c.q[q]);
-      for (int q = 0; q < 4; ++q)
-        for (int h = 0; h < 2; ++h) {
-          Rgba& one = lit[2 * q + h];
-          if (!(one.a > 0)) continue;
-          const float t = float(s + q + 4 * h);
-          one = shade(v, p, ray, o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2], one);
-        }
-      for (int q = 0; q < 4; ++q) c.q[q] = _mm256_load_ps(&lit[2 * q].r);
+      // Light the visible samples, all eight lanes at once (shade_lanes.h).
+      const __m256 u[3] = {u0, u1, u2};
+      shadeQuads(v, p, ray, u, c);
     }
     // Composite the batch, then the batch into the ray.
     gathered = addBehind4(gathered, overQuads(c));

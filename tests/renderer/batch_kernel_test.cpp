@@ -11,6 +11,7 @@
 #include "raycast/cast_ray.h"
 #include "raycast/kernel_setup.h"
 #include "raycast/macrocells.h"
+#include "kernel_fixture.h"
 #include "reference.h"
 #include "transfer.h"
 
@@ -26,20 +27,7 @@ TransferFunctionSpec transfer(std::vector<TransferPoint> points) {
   return tf;
 }
 
-// Kernel parameters for a whole volume, skipping off (every macrocell visible).
-struct Setup {
-  MacrocellGrid macrocells;
-  TransferTable table;
-  std::vector<float> specular;
-  KernelParams p;
-  Setup(const Brick& volume, const TransferFunctionSpec& tf, const RenderOptions& o)
-      : macrocells(volume), table(tf, o.step), specular(specularTable(o.shading.shininess)) {
-    macrocells.classify(table, false);
-    setBrick(p, volume, macrocells);
-    setTables(p, table, nullptr, o.step);
-    setOptions(p, o, specular.data());
-  }
-};
+using Setup = KernelFixture;
 
 // A ray along +x through the middle of an n^3 grid, in index units.
 RaySetup alongX(double y, double z, double step) {

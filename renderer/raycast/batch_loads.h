@@ -1,0 +1,136 @@
+// Loads and small arithmetic shared by the batched kernels (kernel_batch.h)
+// and the batched lighting (shade_lanes.h): eight lanes, one sample each.
+#pragma once
+
+#if defined(__AVX2__) && defined(__FMA__)
+
+#include <immintrin.h>
+
+#include <cstdint>
+#include <cstring>
+#include <type_traits>
+
+namespace pvr::core::kernel {
+
+inline __m256i clampCells8(__m256 u, int lo, int hi) {
+  return _mm256_min_epi32(_mm256_max_epi32(_mm256_cvttps_epi32(u), _mm256_set1_epi32(lo)),
+                          _mm256_set1_epi32(hi));
+}
+
+inline __m256 lerp8(__m256 a, __m256 b, __m256 w) { return _mm256_fmadd_ps(w, _mm256_sub_ps(b, a), a); }
+
+// Integer voxels packed two to a 32-bit lane (the first in the low bits)
+// as floats: the first and the second of each lane.
+template <typename T>
+[[gnu::always_inline]] inline void splitPairs8(__m256i words, __m256& first, __m256& second) {
+  constexpr int kBits = 8 * sizeof(T);
+  if constexpr (std::is_signed_v<T>) {
+    first = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(words, 32 - kBits), 32 - kBits));
+    second = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(words, 32 - 2 * kBits), 32 - kBits));
+  } else {
+    const __m256i mask = _mm256_set1_epi32((1 << kBits) - 1);
+    first = _mm256_cvtepi32_ps(_mm256_and_si256(words, mask));
+    second = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(words, kBits), mask));
+  }
+}
+
+// Eight loaded 32-bit words (four 64-bit) as one vector, each broadcast
+// and blended into place: a broadcast from memory is a load alone and a
+// blend runs on any vector port, where inserting a word (what
+// _mm256_setr_epi32 of loads compiles to) takes the one shuffle port,
+// which the lanes' loads saturate.
+[[gnu::always_inline]] inline __m256i gather8x32(std::int32_t w0, std::int32_t w1, std::int32_t w2, std::int32_t w3,
+                                                 std::int32_t w4, std::int32_t w5, std::int32_t w6, std::int32_t w7) {
+  __m256i v = _mm256_set1_epi32(w0);
+  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w1), 0x02);
+  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w2), 0x04);
+  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w3), 0x08);
+  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w4), 0x10);
+  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w5), 0x20);
+  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w6), 0x40);
+  return _mm256_blend_epi32(v, _mm256_set1_epi32(w7), 0x80);
+}
+[[gnu::always_inline]] inline __m256i gather4x64(long long q0, long long q1, long long q2, long long q3) {
+  __m256i v = _mm256_set1_epi64x(q0);
+  v = _mm256_blend_epi32(v, _mm256_set1_epi64x(q1), 0x0C);
+  v = _mm256_blend_epi32(v, _mm256_set1_epi64x(q2), 0x30);
+  return _mm256_blend_epi32(v, _mm256_set1_epi64x(q3), 0xC0);
+}
+
+// The 64 bits at b + index[j] of eight lanes, as two vectors of 32-bit
+// halves in lane order: `low` gets each lane's first half, `high` its second.
+template <typename T>
+[[gnu::always_inline]] inline void load64x8(const T* b, const std::int32_t* index, __m256& low, __m256& high) {
+  auto at = [b, index](int j) __attribute__((always_inline)) {
+    long long w;
+    std::memcpy(&w, b + index[j], sizeof w);
+    return w;
+  };
+  const __m256 front = _mm256_castsi256_ps(gather4x64(at(0), at(1), at(2), at(3)));  // lanes 0-3
+  const __m256 back = _mm256_castsi256_ps(gather4x64(at(4), at(5), at(6), at(7)));   // lanes 4-7
+  // Halves in lane order 0 1 4 5 | 2 3 6 7; the 64-bit permute puts them in order.
+  low = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0x88)), 0xD8));
+  high = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0xDD)), 0xD8));
+}
+
+// Voxels index[j] + offset and index[j] + offset + 1 of eight lanes.
+template <typename T>
+[[gnu::always_inline]] inline void loadPairs8(const T* v, const std::int32_t* index, std::int64_t offset,
+                                              __m256& lo, __m256& hi) {
+  const T* b = v + offset;
+  if constexpr (std::is_floating_point_v<T>) {
+    load64x8(b, index, lo, hi);
+  } else {
+    // One load of twice the scalar's width holds both neighbours.
+    using Pair = std::conditional_t<sizeof(T) == 1, std::uint16_t, std::uint32_t>;
+    auto pair = [b](std::int32_t at) __attribute__((always_inline)) {
+      Pair w;
+      std::memcpy(&w, b + at, sizeof w);
+      return std::int32_t(w);
+    };
+    const __m256i words = gather8x32(pair(index[0]), pair(index[1]), pair(index[2]), pair(index[3]),
+                                     pair(index[4]), pair(index[5]), pair(index[6]), pair(index[7]));
+    splitPairs8<T>(words, lo, hi);
+  }
+}
+
+// Voxels index[j] + offset + 0 .. 3 of eight lanes, one load per lane:
+// q[n] gets the voxels at + n.
+template <typename T>
+[[gnu::always_inline]] inline void loadQuads8(const T* v, const std::int32_t* index, std::int64_t offset,
+                                              __m256 q[4]) {
+  const T* b = v + offset;
+  if constexpr (std::is_floating_point_v<T>) {
+    // Lanes j and j + 4 in one register, then a 4 x 4 transpose per half.
+    __m256 m[4];
+    for (int j = 0; j < 4; ++j)
+      m[j] = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(b + index[j])), _mm_loadu_ps(b + index[j + 4]), 1);
+    const __m256 t0 = _mm256_unpacklo_ps(m[0], m[1]), t1 = _mm256_unpacklo_ps(m[2], m[3]);
+    const __m256 t2 = _mm256_unpackhi_ps(m[0], m[1]), t3 = _mm256_unpackhi_ps(m[2], m[3]);
+    q[0] = _mm256_shuffle_ps(t0, t1, 0x44);
+    q[1] = _mm256_shuffle_ps(t0, t1, 0xEE);
+    q[2] = _mm256_shuffle_ps(t2, t3, 0x44);
+    q[3] = _mm256_shuffle_ps(t2, t3, 0xEE);
+  } else if constexpr (sizeof(T) == 1) {
+    auto word = [b, index](int j) __attribute__((always_inline)) {
+      std::int32_t w;
+      std::memcpy(&w, b + index[j], sizeof w);
+      return w;
+    };
+    const __m256i words = gather8x32(word(0), word(1), word(2), word(3), word(4), word(5), word(6), word(7));
+    const __m256i mask = _mm256_set1_epi32(0xFF);
+    for (int n = 0; n < 4; ++n) {
+      const __m256i byte = n == 3 ? _mm256_srli_epi32(words, 24) : _mm256_and_si256(_mm256_srli_epi32(words, 8 * n), mask);
+      q[n] = _mm256_cvtepi32_ps(std::is_signed_v<T> ? _mm256_srai_epi32(_mm256_slli_epi32(byte, 24), 24) : byte);
+    }
+  } else {
+    __m256 low, high;
+    load64x8(b, index, low, high);
+    splitPairs8<T>(_mm256_castps_si256(low), q[0], q[1]);
+    splitPairs8<T>(_mm256_castps_si256(high), q[2], q[3]);
+  }
+}
+
+}  // namespace pvr::core::kernel
+
+#endif
