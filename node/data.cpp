@@ -11,6 +11,7 @@
 #include "data_summary.h"
 #include "decompose/content.h"
 #include "io/data_directory.h"
+#include "preprocess.h"
 #include "scene_bricks.h"
 #include "scene_volume.h"
 #include "transfer.h"
@@ -132,6 +133,21 @@ void applyDataDefaults(NodeState& state) {
   classify(state);
 }
 
+// The histogram's fine counts of `brick`: those its read counted, else
+// counted now. A series' steps are read without them (openScene): of the
+// steps `render time` reads, only one the session moves to (set -timestep)
+// is ever summarised, so it pays for its counts when it does.
+std::shared_ptr<const core::FineHistogram> fineCountsOf(NodeState& state, const core::Brick& brick) {
+  if (brick.fineHistogram()) return brick.fineHistogram();
+  const auto start = Clock::now();
+  const core::NodeBox counted = core::countedBox(brick.owned(), brick.grid());
+  std::shared_ptr<const core::FineHistogram> fine =
+      core::preprocessVoxels(brick.type(), brick.owned(), brick.stored(), brick.bytes(), state.pool.get(), &counted)
+          .histogram;
+  state.pendingPreprocess += secondsSince(start);
+  return fine;
+}
+
 // Collective over the world, after a phase that may have failed on this
 // rank: every rank learns the data's value range and histogram (of the
 // bricks on screen), then a rank that failed throws; else the data's
@@ -148,7 +164,10 @@ void agreeOnValueRange(NodeState& state, const std::optional<comm::Failure>& fai
     summary = summaries.front();
   } else {
     const core::Brick* brick = state.current ? &state.current->brick : nullptr;
-    summary = summarizeData(state.world, brick, countsForHistogram(state));
+    const bool counts = countsForHistogram(state);
+    const std::shared_ptr<const core::FineHistogram> counted =
+        brick && counts ? fineCountsOf(state, *brick) : nullptr;
+    summary = summarizeData(state.world, brick, counted.get());
   }
   state.valueRange.reset();
   state.histogram.clear();
@@ -270,6 +289,9 @@ Reload openScene(NodeState& state, const std::string& sceneJson) {
   // Nothing has changed yet: commit.
   if (changed) {
     dropData(state);
+    // A series' steps are read without the histogram's counts, most of
+    // the preprocessing of a step (fineCountsOf counts the step that needs them).
+    if (source->steps() > 1) source->setFineCounts(false);
     state.source = std::move(source);
     state.volumeKey = key;
     state.moreSources.clear();

@@ -43,6 +43,7 @@
 #include "secure_channel.h"
 #include "strategy.h"
 #include "thread_pool.h"
+#include "value_histogram.h"
 
 namespace {
 
@@ -623,7 +624,16 @@ TEST_CASE_METHOD(Fixture, "render time: each frame equals its step's volume, and
   CHECK(statusOf(job)["timestep"] == "0");
   job.send(proto::SetScene{"", R"({"timestep": 2})"});
   job.expect<proto::Ok>();
-  CHECK(statusOf(job)["timestep"] == "2");
+  status = statusOf(job);
+  CHECK(status["timestep"] == "2");
+  // Steps are read without the histogram's counts (node/data.cpp,
+  // fineCountsOf): the step the session moved to, taken from the cache,
+  // reports the histogram of a serial count of its volume.
+  const core::Brick whole2 = core::openVolumeFile((kTmp / "data" / stepFile(2)).string())->readAll();
+  REQUIRE(whole2.fineHistogram());
+  const auto serial2 = core::binHistogram(*whole2.fineHistogram(), whole2.valueRange().min, whole2.valueRange().max);
+  CHECK(numbers(status["histogram"]) == std::vector<double>(serial2.begin(), serial2.end()));
+  CHECK(numbers(status["value_range"]) == std::vector<double>{whole2.valueRange().min, whole2.valueRange().max});
   id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 2, 12});
   const Reference step2(nlohmann::json::object(), stepFile(2));
   checkSequence(job, id, 3, 12, step2);
