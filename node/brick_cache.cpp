@@ -37,6 +37,7 @@ void BrickCache::reset(Reader reader) {
   stopReadAhead();
   std::lock_guard lock(mutex_);
   reader_ = std::move(reader);
+  classifier_ = {};
   held_.clear();
   recent_.clear();
   wanted_.clear();
@@ -103,6 +104,11 @@ void BrickCache::readAhead(std::vector<int> steps) {
   worker_ = std::thread([this] { readAheadLoop(); });
 }
 
+void BrickCache::classifyAhead(AheadClassifier classifier) {
+  std::lock_guard lock(mutex_);
+  classifier_ = std::move(classifier);
+}
+
 void BrickCache::readAheadLoop() {
   // Reading ahead fills the time the render leaves idle; where the cores
   // are all rendering it yields to the render threads.
@@ -118,11 +124,16 @@ void BrickCache::readAheadLoop() {
     const std::vector<int> keep(wanted_.begin(), upTo == wanted_.end() ? upTo : upTo + 1);
     if (stepBytes_ > budget_ || !makeRoom(stepBytes_, keep, false)) break;
     reading_ = step;
+    const AheadClassifier classifier = classifier_;
     lock.unlock();
     const auto start = std::chrono::steady_clock::now();
     std::shared_ptr<ReadyBrick> ready;
     try {
       ready = makeReady(reader_(step), step);
+      if (classifier.classify) {
+        classifier.classify(*ready->renderer);
+        ready->classifiedAs = classifier.generation;
+      }
     } catch (...) {
       // The step's failure is reported when it is needed and read on demand.
     }

@@ -46,16 +46,27 @@ BrickCache::Reader stepReader(const NodeState& state) {
   };
 }
 
-// Puts `ready` on screen and classifies it; charges what it cost to the
-// next frame when it was read for it (not read ahead).
+// Local: classifies the brick on screen for the scene, as the
+// classification in force.
+void classifyShown(NodeState& state) {
+  if (state.current && state.current->scene)
+    state.current->scene->renderer->classify(state.scene.volumes, state.renderOptions, state.pool.get());
+  else if (state.current) state.current->renderer->classify(state.scene.volumes.front().transfer, state.renderOptions, state.pool.get());
+  if (state.current) state.current->classifiedAs = state.classification;
+}
+
+// Puts `ready` on screen and classifies it unless it was read ahead under
+// the classification in force; charges what it cost to the next frame
+// when it was read for it (not read ahead).
 void putOnScreen(NodeState& state, std::shared_ptr<ReadyBrick> ready, bool readNow) {
   state.current = std::move(ready);
   if (readNow) {
     state.pendingRead += state.current->readSeconds;
     state.pendingPreprocess += state.current->preprocessSeconds;
   }
+  if (state.current->classifiedAs == state.classification) return;
   const auto start = Clock::now();
-  classify(state);
+  classifyShown(state);
   state.pendingPreprocess += secondsSince(start);
 }
 
@@ -374,9 +385,16 @@ void showStep(NodeState& state, int step) {
 }
 
 void classify(NodeState& state) {
-  if (state.current && state.current->scene)
-    state.current->scene->renderer->classify(state.scene.volumes, state.renderOptions, state.pool.get());
-  else if (state.current) state.current->renderer->classify(state.scene.volumes.front().transfer, state.renderOptions, state.pool.get());
+  ++state.classification;  // bricks read ahead under the last one classify again when shown
+  classifyShown(state);
+}
+
+AheadClassifier aheadClassifier(const NodeState& state) {
+  if (state.several()) return {};  // nothing is read ahead
+  return {state.classification, [transfer = state.scene.volumes.front().transfer,
+                                  options = state.renderOptions](core::BrickRenderer& renderer) {
+            renderer.classify(transfer, options, nullptr);
+          }};
 }
 
 void rebalanceIfNeeded(NodeState& state) {
