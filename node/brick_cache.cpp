@@ -33,10 +33,11 @@ std::shared_ptr<ReadyBrick> makeReady(core::Brick&& brick, int step) {
   return ready;
 }
 
-void BrickCache::reset(Reader reader) {
+void BrickCache::reset(Reader reader, Prefetcher prefetch) {
   stopReadAhead();
   std::lock_guard lock(mutex_);
   reader_ = std::move(reader);
+  prefetch_ = std::move(prefetch);
   classifier_ = {};
   held_.clear();
   recent_.clear();
@@ -85,6 +86,10 @@ std::shared_ptr<ReadyBrick> BrickCache::take(int step) {
 void BrickCache::readAhead(std::vector<int> steps) {
   {
     std::lock_guard lock(mutex_);
+    // A budget below one step (known once one was read) holds nothing:
+    // the next step is read when shown, from pages asked for now.
+    const bool holdsNone = budget_ == 0 || stepBytes_ > budget_;
+    if (holdsNone && prefetch_ && !steps.empty() && !held_.count(steps.front())) prefetch_(steps.front());
     // Each step once, in order; the background thread reads those not held.
     wanted_.clear();
     queued_.clear();

@@ -79,6 +79,9 @@ class BrickCache {
   // Reads this rank's brick of one step; called on the background thread
   // too, so it must not communicate.
   using Reader = std::function<core::Brick(int step)>;
+  // Announces this rank's brick of one step to the storage
+  // (VolumeSource::prefetchBox); must not communicate either.
+  using Prefetcher = std::function<void(int step)>;
 
   BrickCache() = default;
   BrickCache(const BrickCache&) = delete;
@@ -86,8 +89,11 @@ class BrickCache {
   ~BrickCache() { clear(); }
 
   // Drops every step (a new volume, tree or ghost layers) and reads with
-  // `reader` from now on; a null reader allows no reading ahead.
-  void reset(Reader reader);
+  // `reader` from now on; a null reader allows no reading ahead. A budget
+  // that holds no step reads nothing ahead, but `prefetch` announces the
+  // next step, so its read when it is shown finds the file's pages in
+  // memory (fetched while the frame before rendered).
+  void reset(Reader reader, Prefetcher prefetch = nullptr);
   // Drops every step and the reader.
   void clear() { reset(nullptr); }
   void setBudget(std::uint64_t bytes);
@@ -101,7 +107,8 @@ class BrickCache {
   std::shared_ptr<ReadyBrick> take(int step);
   // Reads `steps` (in the order they will be shown) on the background
   // thread, as many as the budget holds. Replaces any earlier list; a read
-  // in progress goes on.
+  // in progress goes on. When the budget holds no step, announces the
+  // first of them (reset's prefetch) instead.
   void readAhead(std::vector<int> steps);
   // The classification of bricks read ahead from now on (a read in
   // progress keeps the one it started with).
@@ -120,6 +127,7 @@ class BrickCache {
   void evictLocked(int step);  // under mutex_
 
   Reader reader_;
+  Prefetcher prefetch_;
   AheadClassifier classifier_;
   std::uint64_t budget_ = 0;
   mutable std::mutex mutex_;

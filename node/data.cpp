@@ -55,6 +55,14 @@ void classifyShown(NodeState& state) {
   if (state.current) state.current->classifiedAs = state.classification;
 }
 
+// Announces this rank's brick of any step of the open volume (the boxes
+// of the current tree, captured, as stepReader's).
+BrickCache::Prefetcher stepPrefetcher(const NodeState& state) {
+  if (!state.source->canReadPartially()) return nullptr;
+  return [source = state.source.get(), stored = core::storedBox(*state.tree, state.clusterComm->rank(), state.ghost)](
+             int step) { source->step(step).prefetchBox(stored); };
+}
+
 // Puts `ready` on screen and classifies it unless it was read ahead under
 // the classification in force; charges what it cost to the next frame
 // when it was read for it (not read ahead).
@@ -84,7 +92,7 @@ void distributeStep(NodeState& state, int step) {
           : distributeBricks(state.source->step(step), state.scene, state.settings.decomposition, state.ghost, cluster);
   state.tree = std::move(d.tree);
   putOnScreen(state, makeReady(std::move(d.brick), step), true);
-  state.cache.reset(stepReader(state));
+  state.cache.reset(stepReader(state), stepPrefetcher(state));
   state.cache.insert(state.current);
   // The rest of the distribution: decomposition, scatter, waiting.
   state.pendingDist += secondsSince(start) - (state.pendingRead + state.pendingPreprocess - charged);
@@ -439,7 +447,7 @@ void rebalanceIfNeeded(NodeState& state) {
     });
     state.tree = std::move(tree);
     putOnScreen(state, std::move(ready), true);
-    state.cache.reset(stepReader(state));
+    state.cache.reset(stepReader(state), stepPrefetcher(state));
     state.cache.insert(state.current);
     state.pendingDist += secondsSince(start) - (state.pendingRead + state.pendingPreprocess - charged);
   } else {
