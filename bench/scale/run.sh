@@ -88,6 +88,8 @@ PY
   fi
 }
 say "page cache emptied before each cold measurement by: $drop"
+# Other jobs' load changes every figure: it is written beside them.
+load_before=$(cut -d' ' -f1-3 /proc/loadavg)
 
 # Seconds to read FILES sequentially (16 MiB blocks).
 readSeconds() {
@@ -238,7 +240,9 @@ fi
 
 # The table and the plot.
 /usr/bin/python3 "$here/table.py" "$csv" > "$out/$tag.txt"
-{ echo "page cache emptied before each cold measurement by: $drop"; cat "$out/$tag.txt"; } | tee "$out/$tag.txt.new"
+{ echo "page cache emptied before each cold measurement by: $drop"
+  echo "load average (1, 5, 15 min) before: $load_before, after: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) hardware threads"
+  cat "$out/$tag.txt"; } | tee "$out/$tag.txt.new"
 mv "$out/$tag.txt.new" "$out/$tag.txt"
 if [ "$static" = 1 ]; then
   gnuplot -e "csv='$csv'; png='$out/$tag.png'" "$here/plot.gp"
