@@ -60,7 +60,13 @@ void classifyShown(NodeState& state) {
 BrickCache::Prefetcher stepPrefetcher(const NodeState& state) {
   if (!state.source->canReadPartially()) return nullptr;
   return [source = state.source.get(), stored = core::storedBox(*state.tree, state.clusterComm->rank(), state.ghost)](
-             int step) { source->step(step).prefetchBox(stored); };
+             int step) {
+    try {
+      source->step(step).prefetchBox(stored);
+    } catch (...) {
+      // A hint: a step that does not exist fails when it is read.
+    }
+  };
 }
 
 // Puts `ready` on screen and classifies it unless it was read ahead under
