@@ -589,6 +589,15 @@ void openSeries(Job& job) {
   job.expect<proto::Ok>();
 }
 
+// The 256-bin histogram of a serial count of the volume `file` (in the
+// data directory) over its own range, as status reports it.
+std::vector<double> serialHistogram(const std::string& file) {
+  const core::Brick whole = core::openVolumeFile((kTmp / "data" / file).string())->readAll();
+  REQUIRE(whole.fineHistogram());
+  const auto bins = core::binHistogram(*whole.fineHistogram(), whole.valueRange().min, whole.valueRange().max);
+  return {bins.begin(), bins.end()};
+}
+
 // performance cache summed over the render ranks: {hits, misses}.
 std::pair<std::uint64_t, std::uint64_t> cacheCounts(Job& job) {
   job.send(proto::PerformanceRequest{proto::PerformanceQuery::kCache, proto::kAllClusters});
@@ -632,11 +641,9 @@ TEST_CASE_METHOD(Fixture, "render time: each frame equals its step's volume, and
   // Steps are read without the histogram's counts (node/data.cpp,
   // fineCountsOf): the step the session moved to, taken from the cache,
   // reports the histogram of a serial count of its volume.
-  const core::Brick whole2 = core::openVolumeFile((kTmp / "data" / stepFile(2)).string())->readAll();
-  REQUIRE(whole2.fineHistogram());
-  const auto serial2 = core::binHistogram(*whole2.fineHistogram(), whole2.valueRange().min, whole2.valueRange().max);
-  CHECK(numbers(status["histogram"]) == std::vector<double>(serial2.begin(), serial2.end()));
-  CHECK(numbers(status["value_range"]) == std::vector<double>{whole2.valueRange().min, whole2.valueRange().max});
+  CHECK(numbers(status["histogram"]) == serialHistogram(stepFile(2)));
+  const core::ValueRange range2 = core::openVolumeFile((kTmp / "data" / stepFile(2)).string())->readAll().valueRange();
+  CHECK(numbers(status["value_range"]) == std::vector<double>{range2.min, range2.max});
   id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 2, 12});
   const Reference step2(nlohmann::json::object(), stepFile(2));
   checkSequence(job, id, 3, 12, step2);
@@ -715,6 +722,9 @@ TEST_CASE_METHOD(Fixture, "a caching cluster renders the same frames, and its re
   // set -timestep goes through the cache rank too; a rotation keeps the step.
   job.send(proto::SetScene{"", R"({"timestep": 2})"});
   job.expect<proto::Ok>();
+  // The render ranks preprocess a step they receive without the
+  // histogram's counts; the step moved to reports a serial count's.
+  CHECK(numbers(statusOf(job)["histogram"]) == serialHistogram(stepFile(2)));
   id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 1, 12});
   checkSequence(job, id, 2, 12, Reference(nlohmann::json::object(), stepFile(2)));
   CHECK(counts()[2] == 0);
