@@ -33,10 +33,12 @@ std::shared_ptr<ReadyBrick> makeReady(core::Brick&& brick, int step) {
   return ready;
 }
 
-void BrickCache::reset(Reader reader) {
+void BrickCache::reset(Reader reader, Prefetcher prefetch) {
   stopReadAhead();
   std::lock_guard lock(mutex_);
   reader_ = std::move(reader);
+  prefetch_ = std::move(prefetch);
+  classifier_ = {};
   held_.clear();
   recent_.clear();
   wanted_.clear();
@@ -84,6 +86,10 @@ std::shared_ptr<ReadyBrick> BrickCache::take(int step) {
 void BrickCache::readAhead(std::vector<int> steps) {
   {
     std::lock_guard lock(mutex_);
+    // A budget below one step (known once one was read) holds nothing:
+    // the next step is read when shown, from pages asked for now.
+    const bool holdsNone = budget_ == 0 || stepBytes_ > budget_;
+    if (holdsNone && prefetch_ && !steps.empty() && !held_.count(steps.front())) prefetch_(steps.front());
     // Each step once, in order; the background thread reads those not held.
     wanted_.clear();
     queued_.clear();
@@ -103,6 +109,11 @@ void BrickCache::readAhead(std::vector<int> steps) {
   worker_ = std::thread([this] { readAheadLoop(); });
 }
 
+void BrickCache::classifyAhead(AheadClassifier classifier) {
+  std::lock_guard lock(mutex_);
+  classifier_ = std::move(classifier);
+}
+
 void BrickCache::readAheadLoop() {
   // Reading ahead fills the time the render leaves idle; where the cores
   // are all rendering it yields to the render threads.
@@ -118,11 +129,16 @@ void BrickCache::readAheadLoop() {
     const std::vector<int> keep(wanted_.begin(), upTo == wanted_.end() ? upTo : upTo + 1);
     if (stepBytes_ > budget_ || !makeRoom(stepBytes_, keep, false)) break;
     reading_ = step;
+    const AheadClassifier classifier = classifier_;
     lock.unlock();
     const auto start = std::chrono::steady_clock::now();
     std::shared_ptr<ReadyBrick> ready;
     try {
       ready = makeReady(reader_(step), step);
+      if (classifier.classify) {
+        classifier.classify(*ready->renderer);
+        ready->classifiedAs = classifier.generation;
+      }
     } catch (...) {
       // The step's failure is reported when it is needed and read on demand.
     }

@@ -39,6 +39,9 @@ struct ReadyBrick {
   std::shared_ptr<SceneBricks> scene;
   double readSeconds = 0;        // I/O (brick.loadTimes().read)
   double preprocessSeconds = 0;  // fused preprocessing in the reader plus the renderer's build
+  // The classification the renderer holds (AheadClassifier::generation):
+  // 0 when it has none yet.
+  std::uint64_t classifiedAs = 0;
   std::uint64_t bytes() const { return scene ? scene->bytes() : brick.byteSize(); }
   // This rank's part of the frame (BrickRenderer::render, or the scene's).
   core::Image render(const core::Camera& camera, const core::RenderOptions& options, core::ThreadPool& pool,
@@ -50,6 +53,17 @@ struct ReadyBrick {
 
 // Builds the renderer over `brick` (timed) and wraps both.
 std::shared_ptr<ReadyBrick> makeReady(core::Brick&& brick, int step);
+
+// How the step on screen is classified, for the bricks read ahead: the
+// background thread classifies each as it is read (single-threaded, with
+// the copies this holds), so a step from the cache goes on screen without
+// classifying while the classification it was read under (`generation`)
+// is still the one in force. Empty: read-ahead leaves classifying to the
+// step's showing.
+struct AheadClassifier {
+  std::uint64_t generation = 0;
+  std::function<void(core::BrickRenderer&)> classify;
+};
 
 // What `performance cache` reports for one rank.
 struct CacheStats {
@@ -65,6 +79,9 @@ class BrickCache {
   // Reads this rank's brick of one step; called on the background thread
   // too, so it must not communicate.
   using Reader = std::function<core::Brick(int step)>;
+  // Announces this rank's brick of one step to the storage
+  // (VolumeSource::prefetchBox); must not communicate either.
+  using Prefetcher = std::function<void(int step)>;
 
   BrickCache() = default;
   BrickCache(const BrickCache&) = delete;
@@ -72,8 +89,11 @@ class BrickCache {
   ~BrickCache() { clear(); }
 
   // Drops every step (a new volume, tree or ghost layers) and reads with
-  // `reader` from now on; a null reader allows no reading ahead.
-  void reset(Reader reader);
+  // `reader` from now on; a null reader allows no reading ahead. A budget
+  // that holds no step reads nothing ahead, but `prefetch` announces the
+  // next step, so its read when it is shown finds the file's pages in
+  // memory (fetched while the frame before rendered).
+  void reset(Reader reader, Prefetcher prefetch = nullptr);
   // Drops every step and the reader.
   void clear() { reset(nullptr); }
   void setBudget(std::uint64_t bytes);
@@ -87,8 +107,12 @@ class BrickCache {
   std::shared_ptr<ReadyBrick> take(int step);
   // Reads `steps` (in the order they will be shown) on the background
   // thread, as many as the budget holds. Replaces any earlier list; a read
-  // in progress goes on.
+  // in progress goes on. When the budget holds no step, announces the
+  // first of them (reset's prefetch) instead.
   void readAhead(std::vector<int> steps);
+  // The classification of bricks read ahead from now on (a read in
+  // progress keeps the one it started with).
+  void classifyAhead(AheadClassifier classifier);
 
   CacheStats stats() const;
 
@@ -103,6 +127,8 @@ class BrickCache {
   void evictLocked(int step);  // under mutex_
 
   Reader reader_;
+  Prefetcher prefetch_;
+  AheadClassifier classifier_;
   std::uint64_t budget_ = 0;
   mutable std::mutex mutex_;
   std::condition_variable done_;  // a background read ended

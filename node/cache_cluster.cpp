@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <utility>
 
+#include "preprocess.h"
 #include "wave_io.h"
 
 namespace pvr::node {
@@ -85,7 +87,11 @@ std::shared_ptr<ReadyBrick> receiveStep(NodeState& state, int step) {
                                             std::to_string(bytes.size() - 1) + " bytes, expected " +
                                             std::to_string(brick.byteSize()));
     std::memcpy(brick.bytes(), bytes.data() + 1, brick.byteSize());
-    brick.updateValueRange();
+    // Range and macrocell bounds, without the histogram's counts: a step
+    // the session moves to is counted when its histogram is agreed (data.cpp).
+    core::Preprocessed p = core::preprocessVoxels(brick.type(), brick.owned(), brick.stored(),
+                                                  std::as_const(brick).bytes(), state.pool.get());
+    brick.setPreprocessed(p.range, std::move(p.bounds), nullptr);
     ready = makeReady(std::move(brick), step);
   });
   return ready;

@@ -11,6 +11,7 @@
 #include "data_summary.h"
 #include "decompose/content.h"
 #include "io/data_directory.h"
+#include "preprocess.h"
 #include "scene_bricks.h"
 #include "scene_volume.h"
 #include "transfer.h"
@@ -45,16 +46,41 @@ BrickCache::Reader stepReader(const NodeState& state) {
   };
 }
 
-// Puts `ready` on screen and classifies it; charges what it cost to the
-// next frame when it was read for it (not read ahead).
+// Local: classifies the brick on screen for the scene, as the
+// classification in force.
+void classifyShown(NodeState& state) {
+  if (state.current && state.current->scene)
+    state.current->scene->renderer->classify(state.scene.volumes, state.renderOptions, state.pool.get());
+  else if (state.current) state.current->renderer->classify(state.scene.volumes.front().transfer, state.renderOptions, state.pool.get());
+  if (state.current) state.current->classifiedAs = state.classification;
+}
+
+// Announces this rank's brick of any step of the open volume (the boxes
+// of the current tree, captured, as stepReader's).
+BrickCache::Prefetcher stepPrefetcher(const NodeState& state) {
+  if (!state.source->canReadPartially()) return nullptr;
+  return [source = state.source.get(), stored = core::storedBox(*state.tree, state.clusterComm->rank(), state.ghost)](
+             int step) {
+    try {
+      source->step(step).prefetchBox(stored);
+    } catch (...) {
+      // A hint: a step that does not exist fails when it is read.
+    }
+  };
+}
+
+// Puts `ready` on screen and classifies it unless it was read ahead under
+// the classification in force; charges what it cost to the next frame
+// when it was read for it (not read ahead).
 void putOnScreen(NodeState& state, std::shared_ptr<ReadyBrick> ready, bool readNow) {
   state.current = std::move(ready);
   if (readNow) {
     state.pendingRead += state.current->readSeconds;
     state.pendingPreprocess += state.current->preprocessSeconds;
   }
+  if (state.current->classifiedAs == state.classification) return;
   const auto start = Clock::now();
-  classify(state);
+  classifyShown(state);
   state.pendingPreprocess += secondsSince(start);
 }
 
@@ -72,7 +98,7 @@ void distributeStep(NodeState& state, int step) {
           : distributeBricks(state.source->step(step), state.scene, state.settings.decomposition, state.ghost, cluster);
   state.tree = std::move(d.tree);
   putOnScreen(state, makeReady(std::move(d.brick), step), true);
-  state.cache.reset(stepReader(state));
+  state.cache.reset(stepReader(state), stepPrefetcher(state));
   state.cache.insert(state.current);
   // The rest of the distribution: decomposition, scatter, waiting.
   state.pendingDist += secondsSince(start) - (state.pendingRead + state.pendingPreprocess - charged);
@@ -376,9 +402,16 @@ void showStep(NodeState& state, int step) {
 }
 
 void classify(NodeState& state) {
-  if (state.current && state.current->scene)
-    state.current->scene->renderer->classify(state.scene.volumes, state.renderOptions, state.pool.get());
-  else if (state.current) state.current->renderer->classify(state.scene.volumes.front().transfer, state.renderOptions, state.pool.get());
+  ++state.classification;  // bricks read ahead under the last one classify again when shown
+  classifyShown(state);
+}
+
+AheadClassifier aheadClassifier(const NodeState& state) {
+  if (state.several()) return {};  // nothing is read ahead
+  return {state.classification, [transfer = state.scene.volumes.front().transfer,
+                                  options = state.renderOptions](core::BrickRenderer& renderer) {
+            renderer.classify(transfer, options, nullptr);
+          }};
 }
 
 void rebalanceIfNeeded(NodeState& state) {
@@ -423,7 +456,7 @@ void rebalanceIfNeeded(NodeState& state) {
     });
     state.tree = std::move(tree);
     putOnScreen(state, std::move(ready), true);
-    state.cache.reset(stepReader(state));
+    state.cache.reset(stepReader(state), stepPrefetcher(state));
     state.cache.insert(state.current);
     state.pendingDist += secondsSince(start) - (state.pendingRead + state.pendingPreprocess - charged);
   } else {

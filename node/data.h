@@ -57,8 +57,15 @@ void showStep(NodeState& state, int step);
 // rebuild the tree when max/mean content passes the threshold.
 void rebalanceIfNeeded(NodeState& state);
 
-// Local: (re)builds the renderer's tables for the current scene.
+// Local: (re)builds the renderer's tables for the current scene. Every
+// call starts a new classification (NodeState::classification): call it
+// on every change of the transfer function or the render options.
 void classify(NodeState& state);
+
+// The classification in force, for the bricks the cache reads ahead
+// (brick_cache.h, AheadClassifier): copies of the transfer function and
+// render options, so the background thread never reads the state.
+AheadClassifier aheadClassifier(const NodeState& state);
 
 // Drops the dataset (after a layout change every cluster re-reads).
 void dropData(NodeState& state);

@@ -112,6 +112,9 @@ struct NodeState {
   std::shared_ptr<ReadyBrick> current;
   // Steps held and read ahead for this rank (brick_cache.h); dropped with the tree.
   BrickCache cache;
+  // The classification in force (ReadyBrick::classifiedAs): counts up on
+  // every change of what classifying depends on (data.h, classify).
+  std::uint64_t classification = 1;
   // Cache ranks (cache_cluster.h): per render rank served, by (render
   // cluster, index in it), its steps and the step it shows.
   struct ServedRank {

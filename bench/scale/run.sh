@@ -62,7 +62,7 @@ unset PVR_SUMMARY_CACHE
 summary_dir=$data/summaries
 [ "$summaries" = 1 ] && rm -rf "$summary_dir"
 csv=$out/$tag.csv log=$out/$tag.log
-echo "kind,ranks,cache,voxels,wall_s,read_file_s,start,read,prep,dist,rend,comp,comm,send,write,frames,fps,rss_max_mb,rss_mb_per_rank" > "$csv"
+echo "kind,ranks,cache,voxels,wall_s,read_file_s,start,read,prep,dist,rend,comp,comm,send,write,frames,fps,rss_max_mb,rss_mb_per_rank,cpu_s_frame" > "$csv"
 : > "$log"
 say() { echo "$*" | tee -a "$log"; }
 now() { date +%s.%N; }
@@ -88,6 +88,8 @@ PY
   fi
 }
 say "page cache emptied before each cold measurement by: $drop"
+# Other jobs' load changes every figure: it is written beside them.
+load_before=$(cut -d' ' -f1-3 /proc/loadavg)
 
 # Seconds to read FILES sequentially (16 MiB blocks).
 readSeconds() {
@@ -157,7 +159,7 @@ top = lambda k: max(float(r[k]) for r in rows)
 rss = [float(r["peak_rss_bytes"]) / 2**20 for r in rows]
 print(",".join(["batch", n, cache, voxels, "%.4f" % float(wall), readfile] +
                ["%.4f" % top(k) for k in ("start", "read", "prep", "dist", "rend", "comp", "comm", "send", "write")] +
-               ["1", "", "%.1f" % max(rss), " ".join("%.1f" % v for v in rss)]))
+               ["1", "", "%.1f" % max(rss), " ".join("%.1f" % v for v in rss), ""]))
 PY
   tail -n 1 "$csv" | tee -a "$log"
 }
@@ -178,8 +180,8 @@ if [ "$static" = 1 ]; then
   dropCache "$raw"
   cold_read=$(readSeconds "$raw")
   warm_read=$(readSeconds "$raw")
-  echo "read,1,cold,$voxels,$cold_read,$cold_read,,,,,,,,,,,,," >> "$csv"
-  echo "read,1,warm,$voxels,$warm_read,$warm_read,,,,,,,,,,,,," >> "$csv"
+  echo "read,1,cold,$voxels,$cold_read,$cold_read,,,,,,,,,,,,,," >> "$csv"
+  echo "read,1,warm,$voxels,$warm_read,$warm_read,,,,,,,,,,,,,," >> "$csv"
   say "sequential read of $raw: cold $cold_read s, warm $warm_read s"
 
   for n in $ranks; do
@@ -238,7 +240,9 @@ fi
 
 # The table and the plot.
 /usr/bin/python3 "$here/table.py" "$csv" > "$out/$tag.txt"
-{ echo "page cache emptied before each cold measurement by: $drop"; cat "$out/$tag.txt"; } | tee "$out/$tag.txt.new"
+{ echo "page cache emptied before each cold measurement by: $drop"
+  echo "load average (1, 5, 15 min) before: $load_before, after: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) hardware threads"
+  cat "$out/$tag.txt"; } | tee "$out/$tag.txt.new"
 mv "$out/$tag.txt.new" "$out/$tag.txt"
 if [ "$static" = 1 ]; then
   gnuplot -e "csv='$csv'; png='$out/$tag.png'" "$here/plot.gp"

@@ -19,7 +19,9 @@
 # job's start, the dataset load and the frame); start is `open` alone; the
 # phases are the first frame's (max over ranks, as the collector reports
 # them); fps is frames over the last frame's arrival; rss from VmHWM of
-# every pvr-node under pvrd PID, read before `close`, in pid order.
+# every pvr-node under pvrd PID, read before `close`, in pid order;
+# cpu_s_frame is their CPU time (all threads, summed over the ranks) from
+# the first frame's arrival to the last's, over the frames after the first.
 set defaults {-host "" -pvrd 0 -dataset "" -csv "" -kind pvrsh -cache warm -ranks 8 -size 512 -settings ""
               -frames 20 -readfile "" -voxels 0 -series 0 -cachemem ""}
 source [file join [file dirname [info script]] .. lib options.tcl]
@@ -27,41 +29,64 @@ benchOptions session.tcl $defaults $argv
 set ::pvr::progress 0
 set phases $::pvr::phases
 
-# pvrNodePeaks: the peak RSS (MB) of every pvr-node descending from pid
-# `root`, in pid order (ranks start in rank order).
-proc pvrNodePeaks {root} {
+# readProc: the text of /proc/PID/FILE, or "" when the process is gone.
+proc readProc {pid file} {
+    if {[catch {
+        set f [open /proc/$pid/$file]
+        set text [read $f]
+        close $f
+    }]} { return "" }
+    return $text
+}
+
+# pvrNodePids: every pvr-node descending from pid `root`, in pid order
+# (ranks start in rank order).
+proc pvrNodePids {root} {
     set parent [dict create]
     set name [dict create]
     foreach dir [glob -nocomplain -directory /proc {[0-9]*}] {
-        if {[catch {
-            set f [open $dir/stat]
-            set stat [read $f]
-            close $f
-        }]} continue
+        set pid [file tail $dir]
+        if {[set stat [readProc $pid stat]] eq ""} continue
         # The command name is in parentheses and may hold spaces.
         set close [string last ")" $stat]
-        set pid [file tail $dir]
         dict set name $pid [string range $stat [expr {[string first "(" $stat] + 1}] [expr {$close - 1}]]
         dict set parent $pid [lindex [string range $stat [expr {$close + 2}] end] 1]
     }
-    set peaks {}
+    set pids {}
     foreach pid [lsort -integer [dict keys $name]] {
         if {[dict get $name $pid] ne "pvr-node"} continue
         for {set p $pid} {$p > 1 && $p != $root} {set p [dict get $parent $p]} {
             if {![dict exists $parent $p]} break
         }
-        if {$p != $root} continue
-        if {[catch {
-            set f [open /proc/$pid/status]
-            set status [read $f]
-            close $f
-        }]} continue
-        if {[regexp {VmHWM:\s+(\d+) kB} $status -> kb]} {
+        if {$p == $root} { lappend pids $pid }
+    }
+    return $pids
+}
+
+# pvrNodePeaks: the peak RSS (MB) of each of `pids`.
+proc pvrNodePeaks {pids} {
+    set peaks {}
+    foreach pid $pids {
+        if {[regexp {VmHWM:\s+(\d+) kB} [readProc $pid status] -> kb]} {
             lappend peaks [format %.1f [expr {$kb / 1024.0}]]
         }
     }
     return $peaks
 }
+
+# pvrNodeCpu: the CPU seconds (user + system, every thread) `pids` have
+# used so far. Summed over the ranks it is the work a frame costs, which
+# on a machine shared with other jobs varies far less than its wall time.
+proc pvrNodeCpu {pids} {
+    set ticks 0
+    foreach pid $pids {
+        if {[set stat [readProc $pid stat]] eq ""} continue
+        set fields [string range $stat [expr {[string last ")" $stat] + 2}] end]
+        incr ticks [expr {[lindex $fields 11] + [lindex $fields 12]}]
+    }
+    return [expr {$ticks / double($::clockTicks)}]
+}
+set clockTicks [exec getconf CLK_TCK]
 
 set t0 [clock microseconds]
 pvr_session :s
@@ -74,6 +99,8 @@ if {$opt(-cachemem) ne ""} { lappend settings -cachemem $opt(-cachemem) }
 :s wait -timeout 3600
 set first [lindex [:s timing] 0]
 set firstAt [clock microseconds]
+set pids [pvrNodePids $opt(-pvrd)]
+set cpuBefore [pvrNodeCpu $pids]
 
 # The frames after the first.
 if {$opt(-series)} {
@@ -85,11 +112,21 @@ if {$opt(-series)} {
 }
 :s wait -timeout 3600
 set records [:s timing]
+set cpuPerFrame [expr {([pvrNodeCpu $pids] - $cpuBefore) / $frames}]
 set fps [expr {$frames / [dict get [lindex $records end] arrival]}]
+# Where a later frame's time goes: each phase's mean over the frames after
+# the first (for a series, the per-step cost of reading and preprocessing
+# beside the render's), in the log beside the first frame's.
+set later [lmap p $phases {
+    set sum 0.0
+    foreach r $records { set sum [expr {$sum + [dict get $r $p]}] }
+    format "%s %.3f" $p [expr {$sum / max(1, [llength $records])}]
+}]
+puts "$opt(-kind) mean per frame after the first: [join $later " "]"
 if {$opt(-series) && ![catch {:s performance cache} cache]} {
     puts "$opt(-kind) cache after `render time`: $cache"
 }
-set peaks [pvrNodePeaks $opt(-pvrd)]
+set peaks [pvrNodePeaks $pids]
 :s close
 
 set wall [expr {($firstAt - $t0) * 1e-6}]
@@ -98,10 +135,10 @@ set row [list $opt(-kind) $opt(-ranks) $opt(-cache) $opt(-voxels) [format %.4f $
 foreach p $phases { lappend row [format %.4f [dict get $first $p]] }
 lappend row "" $frames [format %.3f $fps]
 set rssMax [expr {[llength $peaks] ? [tcl::mathfunc::max {*}$peaks] : ""}]
-lappend row $rssMax [join $peaks " "]
+lappend row $rssMax [join $peaks " "] [format %.4f $cpuPerFrame]
 set f [open $opt(-csv) a]
 puts $f [join $row ,]
 close $f
-puts [format "%-15s %d ranks %-4s first frame %.3f s (open %.3f s; %s), then %d frames at %.2f fps; peak RSS MB %s" \
+puts [format "%-15s %d ranks %-4s first frame %.3f s (open %.3f s; %s), then %d frames at %.2f fps, %.3f CPU s per frame over the ranks; peak RSS MB %s" \
       $opt(-kind) $opt(-ranks) $opt(-cache) $wall [expr {($opened - $t0) * 1e-6}] \
-      [join [lmap p $phases {format "%s %.3f" $p [dict get $first $p]}] " "] $frames $fps $peaks]
+      [join [lmap p $phases {format "%s %.3f" $p [dict get $first $p]}] " "] $frames $fps $cpuPerFrame $peaks]

@@ -59,6 +59,19 @@ def main(path):
     series = {r["kind"]: r for r in rows if r["kind"].startswith("series-")}
     if series:
         print("series: %s" % ", ".join("%s %s fps" % (k, fmt(num(r, "fps"), "%.2f")) for k, r in sorted(series.items())))
+        # The work of a frame, summed over the ranks (older results lack it):
+        # beside the static one it is what each step costs on top.
+        if any(num(r, "cpu_s_frame") for r in series.values()):
+            static = num(series["series-static"], "cpu_s_frame") if "series-static" in series else None
+            print("series CPU s per frame over the ranks: %s" % ", ".join(
+                "%s %s%s" % (k, fmt(num(r, "cpu_s_frame")),
+                             " (%.2fx static)" % (num(r, "cpu_s_frame") / static)
+                             if static and num(r, "cpu_s_frame") and k != "series-static" else "")
+                for k, r in sorted(series.items())))
+            if static:
+                for k, r in sorted(series.items()):
+                    if k != "series-static" and num(r, "fps") and num(series["series-static"], "fps"):
+                        print("%s: %.0f %% of the static frame rate" % (k, 100 * num(r, "fps") / num(series["series-static"], "fps")))
 
 
 if __name__ == "__main__":

@@ -49,6 +49,7 @@ void renderMyFrame(NodeState& state, const Wave& args, std::optional<comm::Failu
       const comm::LivenessScope loading(state.liveness, comm::LivenessScope::Kind::kLoading);
       showStep(state, w.timestep);
     }
+    state.cache.classifyAhead(aheadClassifier(state));
     state.cache.readAhead(myUpcoming(args.upcoming, me.group, state.layout.groups));
     if (!state.current) throw Error(ErrorCode::kInvalidArgument, "no dataset: send SetScene with a dataset first");
     state.maybeFail("render");

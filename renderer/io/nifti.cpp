@@ -133,6 +133,7 @@ class ScaledSource final : public VolumeSource {
   }
   std::string caveat() const override { return stored_->caveat(); }
   void setFineCounts(bool on) override { stored_->setFineCounts(on); }
+  void prefetchBox(const NodeBox& stored) const override { stored_->prefetchBox(stored); }
   std::string describe() const override {
     return stored_->describe() + " scaled to float32 (" + std::to_string(slope_) + " * v + " +
            std::to_string(inter_) + ")";

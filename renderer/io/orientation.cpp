@@ -77,6 +77,9 @@ class ReorientedSource final : public VolumeSource {
   }
   std::string caveat() const override { return obliqueWarning(o_); }
   void setFineCounts(bool on) override { inner_->setFineCounts(on); }
+  void prefetchBox(const NodeBox& stored) const override {
+    inner_->prefetchBox(o_.reorders() ? toFile(stored) : stored);
+  }
 
   Brick readBox(const NodeBox& owned, const NodeBox& stored) const override {
     // An oblique file on its own axes needs no reordering, only its caveat.

@@ -66,6 +66,9 @@ class RawVolumeSource final : public VolumeSource {
     return readRawBox(layout_, grid_, type_, owned, stored, fineCounts_);
   }
   void setFineCounts(bool on) override { fineCounts_ = on; }
+  void prefetchBox(const NodeBox& stored) const override {
+    if (canReadPartially()) prefetchRawBox(layout_, grid_, type_, stored);
+  }
   std::string describe() const override { return name_ + ": " + shapeText(grid_, type_); }
 
  private:
@@ -105,6 +108,29 @@ std::unique_ptr<VolumeSource> openRawVolume(std::string name, const GridGeometry
     failAt(ErrorCode::kBadFile, layout.dataPath, what + shapeText(grid, type) + ")");
   });
   return rawVolumeSource(std::move(name), grid, type, std::move(layout));
+}
+
+void prefetchRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType type, const NodeBox& stored) {
+  if (layout.encoding != RawEncoding::kRaw || stored.empty() || !grid.allNodes().contains(stored)) return;
+  const std::size_t size = scalarSize(type);
+  const IVec3 d = grid.dims;
+  auto offsetOf = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+    return layout.offset + std::uint64_t((z * d.y + y) * d.x + x) * size;
+  };
+  try {
+    FileStream stream(layout.dataPath);
+    // One range per slab, from its first row to the end of its last (the
+    // gaps share the rows' pages); whole slabs are one range.
+    const bool wholeSlabs = stored.extent(0) == d.x && stored.extent(1) == d.y;
+    const std::int64_t zEnd = wholeSlabs ? stored.lo.z : stored.hi.z;
+    for (std::int64_t z = stored.lo.z; z <= zEnd; ++z) {
+      const std::uint64_t first = offsetOf(stored.lo.x, stored.lo.y, z);
+      const std::uint64_t end = offsetOf(stored.hi.x, stored.hi.y, wholeSlabs ? stored.hi.z : z) + size;
+      stream.willNeed(first, std::size_t(end - first));
+    }
+  } catch (...) {
+    // A hint: the read itself reports what is wrong with the file.
+  }
 }
 
 Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType type,

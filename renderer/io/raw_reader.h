@@ -72,4 +72,9 @@ std::unique_ptr<VolumeSource> openRawVolume(std::string name, const GridGeometry
 Brick readRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType type,
                  const NodeBox& owned, const NodeBox& stored, bool fineCounts = true);
 
+// VolumeSource::prefetchBox for raw data (gzip streams ignore it): the
+// byte ranges readRawBox would read for `stored`, announced to the kernel.
+// Never throws.
+void prefetchRawBox(const RawLayout& layout, const GridGeometry& grid, ScalarType type, const NodeBox& stored);
+
 }  // namespace pvr::core

@@ -45,6 +45,14 @@ class VolumeSource {
   // pass it on.
   virtual void setFineCounts(bool /*on*/) {}
 
+  // Asks the storage to start fetching the nodes of `stored` (a later
+  // readBox's stored box) without waiting for them, so that read finds
+  // them in memory: raw files announce the box's byte ranges to the
+  // kernel (ByteStream::willNeed). Only a hint: sources that cannot give
+  // it, and any failure, change nothing. For a series step read on demand
+  // after the frame now rendering (node/brick_cache.h).
+  virtual void prefetchBox(const NodeBox& /*stored*/) const {}
+
   // A time series is steps() volumes on one grid and scalar type: step(k)
   // (0-based) is the k-th, stepTime(k) its time. A single volume is a series
   // of one step, itself. readBox of a series reads its step 0.

@@ -4,6 +4,7 @@
 // the next steps into hits.
 #include <catch2/catch.hpp>
 #include <atomic>
+#include <vector>
 
 #include "brick_cache.h"
 #include "io/volume_io.h"
@@ -68,6 +69,25 @@ TEST_CASE("a budget below one step holds nothing and every step is read when nee
   CHECK(cache.stats().hits == 0);
   CHECK(cache.stats().misses == 6);
   CHECK(cache.stats().bytesHeld == 0);
+}
+
+TEST_CASE("a budget below one step announces the next step to the storage, and one that holds steps reads it") {
+  StepReader steps;
+  BrickCache cache;
+  std::vector<int> announced;
+  cache.setBudget(kStepBytes - 1);
+  cache.reset(steps.reader(), [&](int step) { announced.push_back(step); });
+  cache.take(0);      // one step read: its size is known to exceed the budget
+  cache.readAhead({1, 2});
+  CHECK(announced == std::vector<int>{1});  // the next one only
+  CHECK(*steps.reads == 1);                  // and nothing read ahead
+  // A budget of two steps reads them ahead instead.
+  announced.clear();
+  cache.setBudget(2 * kStepBytes);
+  cache.readAhead({1, 2});
+  CHECK(cache.take(1)->step == 1);
+  CHECK(cache.stats().hits == 1);
+  CHECK(announced.empty());
 }
 
 TEST_CASE("read-ahead makes the upcoming steps hits, and never evicts a step on screen") {

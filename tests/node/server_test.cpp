@@ -409,7 +409,9 @@ core::Image dumped(const Job& job, std::uint32_t request, int frame) {
 }
 
 // A sequence's frames: in order, the last FINAL, frame k equal to want(k).
-void checkFrames(Job& job, std::uint32_t request, int frames, const std::function<core::Image(int)>& want) {
+// `timings`, when given, gets each frame's timing.
+void checkFrames(Job& job, std::uint32_t request, int frames, const std::function<core::Image(int)>& want,
+                 std::vector<proto::FrameTiming>* timings = nullptr) {
   for (int k = 0; k < frames; ++k) {
     auto d = job.receive();
     REQUIRE(d);
@@ -419,6 +421,7 @@ void checkFrames(Job& job, std::uint32_t request, int frames, const std::functio
     CHECK(f.frameNumber == std::uint32_t(k));
     CHECK(d->info.final() == (k == frames - 1));
     CHECK(f.timing.render > 0);
+    if (timings) timings->push_back(f.timing);
     const double diff = core::maxAbsDifference(dumped(job, request, k), want(k));
     INFO("frame " << k);
     CHECK(diff <= 1e-5);
@@ -591,6 +594,15 @@ void openSeries(Job& job) {
   job.expect<proto::Ok>();
 }
 
+// The 256-bin histogram of a serial count of the volume `file` (in the
+// data directory) over its own range, as status reports it.
+std::vector<double> serialHistogram(const std::string& file) {
+  const core::Brick whole = core::openVolumeFile((kTmp / "data" / file).string())->readAll();
+  REQUIRE(whole.fineHistogram());
+  const auto bins = core::binHistogram(*whole.fineHistogram(), whole.valueRange().min, whole.valueRange().max);
+  return {bins.begin(), bins.end()};
+}
+
 // performance cache summed over the render ranks: {hits, misses}.
 std::pair<std::uint64_t, std::uint64_t> cacheCounts(Job& job) {
   job.send(proto::PerformanceRequest{proto::PerformanceQuery::kCache, proto::kAllClusters});
@@ -629,10 +641,50 @@ TEST_CASE_METHOD(Fixture, "render time: each frame equals its step's volume, and
   CHECK(statusOf(job)["timestep"] == "0");
   job.send(proto::SetScene{"", R"({"timestep": 2})"});
   job.expect<proto::Ok>();
-  CHECK(statusOf(job)["timestep"] == "2");
+  status = statusOf(job);
+  CHECK(status["timestep"] == "2");
+  // Steps are read without the histogram's counts (node/data.cpp,
+  // countHistogram): the step the session moved to, taken from the cache,
+  // reports the histogram of a serial count of its volume when asked.
+  CHECK(numbers(status["histogram"]) == serialHistogram(stepFile(2)));
+  const core::ValueRange range2 = core::openVolumeFile((kTmp / "data" / stepFile(2)).string())->readAll().valueRange();
+  CHECK(numbers(status["value_range"]) == std::vector<double>{range2.min, range2.max});
   id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 2, 12});
   const Reference step2(nlohmann::json::object(), stepFile(2));
   checkSequence(job, id, 3, 12, step2);
+  CHECK(job.close());
+}
+
+TEST_CASE_METHOD(Fixture, "steps read ahead are classified ahead, and again when the transfer function changes", "[series]") {
+  Job job(2, {});
+  openSeries(job);
+  // Steps 1-3 are read ahead while the frame before renders, and
+  // classified there: their frames charge no reading and no preprocessing.
+  std::vector<proto::FrameTiming> timings;
+  auto id = job.send(proto::RenderTimeSteps{0, 3, 1});
+  checkFrames(job, id, 4, [&](int k) { return Reference(nlohmann::json::object(), stepFile(k)).frame(0, 1); },
+              &timings);
+  REQUIRE(timings.size() == 4);
+  for (int k = 1; k < 4; ++k) {
+    INFO("frame " << k);
+    CHECK(timings[std::size_t(k)].read == 0);
+    CHECK(timings[std::size_t(k)].preprocess == 0);
+  }
+  // A transfer function set after they were read ahead: held steps 1 and
+  // 2 were classified under the old one and are classified again when
+  // shown; step 3, on screen when it changed, was classified then.
+  const char* narrow =
+      R"({"transfer_function": {"points": [[0, 0, 0, 0, 0], [0.22, 0, 0, 0, 0], [0.3, 1, 0.9, 0.8, 0.8], [0.38, 0, 0, 0, 0], [1, 0, 0, 0, 0]]}})";
+  job.send(proto::SetScene{"", narrow});
+  job.expect<proto::Ok>();
+  timings.clear();
+  id = job.send(proto::RenderTimeSteps{1, 3, 1});
+  checkFrames(job, id, 3,
+              [&](int k) { return Reference(nlohmann::json::parse(narrow), stepFile(1 + k)).frame(0, 1); }, &timings);
+  REQUIRE(timings.size() == 3);
+  CHECK(timings[0].preprocess > 0);
+  CHECK(timings[1].preprocess > 0);
+  CHECK(timings[2].preprocess == 0);
   CHECK(job.close());
 }
 
@@ -675,6 +727,9 @@ TEST_CASE_METHOD(Fixture, "a caching cluster renders the same frames, and its re
   // set -timestep goes through the cache rank too; a rotation keeps the step.
   job.send(proto::SetScene{"", R"({"timestep": 2})"});
   job.expect<proto::Ok>();
+  // The render ranks preprocess a step they receive without the
+  // histogram's counts; the step moved to reports a serial count's.
+  CHECK(numbers(statusOf(job)["histogram"]) == serialHistogram(stepFile(2)));
   id = job.send(proto::RenderRotation{{0, 1, 0}, 0, 1, 12});
   checkSequence(job, id, 2, 12, Reference(nlohmann::json::object(), stepFile(2)));
   CHECK(counts()[2] == 0);
