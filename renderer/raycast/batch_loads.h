@@ -34,29 +34,6 @@ template <typename T>
   }
 }
 
-// Eight loaded 32-bit words (four 64-bit) as one vector, each broadcast
-// and blended into place: a broadcast from memory is a load alone and a
-// blend runs on any vector port, where inserting a word (what
-// _mm256_setr_epi32 of loads compiles to) takes the one shuffle port,
-// which the lanes' loads saturate.
-[[gnu::always_inline]] inline __m256i gather8x32(std::int32_t w0, std::int32_t w1, std::int32_t w2, std::int32_t w3,
-                                                 std::int32_t w4, std::int32_t w5, std::int32_t w6, std::int32_t w7) {
-  __m256i v = _mm256_set1_epi32(w0);
-  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w1), 0x02);
-  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w2), 0x04);
-  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w3), 0x08);
-  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w4), 0x10);
-  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w5), 0x20);
-  v = _mm256_blend_epi32(v, _mm256_set1_epi32(w6), 0x40);
-  return _mm256_blend_epi32(v, _mm256_set1_epi32(w7), 0x80);
-}
-[[gnu::always_inline]] inline __m256i gather4x64(long long q0, long long q1, long long q2, long long q3) {
-  __m256i v = _mm256_set1_epi64x(q0);
-  v = _mm256_blend_epi32(v, _mm256_set1_epi64x(q1), 0x0C);
-  v = _mm256_blend_epi32(v, _mm256_set1_epi64x(q2), 0x30);
-  return _mm256_blend_epi32(v, _mm256_set1_epi64x(q3), 0xC0);
-}
-
 // The 64 bits at b + index[j] of eight lanes, as two vectors of 32-bit
 // halves in lane order: `low` gets each lane's first half, `high` its second.
 template <typename T>
@@ -66,8 +43,8 @@ template <typename T>
     std::memcpy(&w, b + index[j], sizeof w);
     return w;
   };
-  const __m256 front = _mm256_castsi256_ps(gather4x64(at(0), at(1), at(2), at(3)));  // lanes 0-3
-  const __m256 back = _mm256_castsi256_ps(gather4x64(at(4), at(5), at(6), at(7)));   // lanes 4-7
+  const __m256 front = _mm256_castsi256_ps(_mm256_setr_epi64x(at(0), at(1), at(2), at(3)));  // lanes 0-3
+  const __m256 back = _mm256_castsi256_ps(_mm256_setr_epi64x(at(4), at(5), at(6), at(7)));   // lanes 4-7
   // Halves in lane order 0 1 4 5 | 2 3 6 7; the 64-bit permute puts them in order.
   low = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0x88)), 0xD8));
   high = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0xDD)), 0xD8));
@@ -88,8 +65,8 @@ template <typename T>
       std::memcpy(&w, b + at, sizeof w);
       return std::int32_t(w);
     };
-    const __m256i words = gather8x32(pair(index[0]), pair(index[1]), pair(index[2]), pair(index[3]),
-                                     pair(index[4]), pair(index[5]), pair(index[6]), pair(index[7]));
+    const __m256i words = _mm256_setr_epi32(pair(index[0]), pair(index[1]), pair(index[2]), pair(index[3]),
+                                            pair(index[4]), pair(index[5]), pair(index[6]), pair(index[7]));
     splitPairs8<T>(words, lo, hi);
   }
 }
@@ -117,7 +94,7 @@ template <typename T>
       std::memcpy(&w, b + index[j], sizeof w);
       return w;
     };
-    const __m256i words = gather8x32(word(0), word(1), word(2), word(3), word(4), word(5), word(6), word(7));
+    const __m256i words = _mm256_setr_epi32(word(0), word(1), word(2), word(3), word(4), word(5), word(6), word(7));
     const __m256i mask = _mm256_set1_epi32(0xFF);
     for (int n = 0; n < 4; ++n) {
       const __m256i byte = n == 3 ? _mm256_srli_epi32(words, 24) : _mm256_and_si256(_mm256_srli_epi32(words, 8 * n), mask);

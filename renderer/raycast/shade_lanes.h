@@ -139,24 +139,6 @@ template <typename T>
   }
 }
 
-// 1 / sqrt(x) for x in [1e-20, FLT_MAX] (the lighted lanes; the others'
-// results are unused), to a relative 4e-7 of 1 / std::sqrt(x): the
-// hardware estimate (relative error e below 2^-14 with AVX-512, 1.5 *
-// 2^-12 without) and one Newton step, which leaves 1.5 e^2 (under 2.1e-7)
-// plus its own rounding; 2 float ulps seen here with AVX-512. Replaces a
-// square root and a divide, one dependent chain of ~30 cycles a batch, by
-// ~4 + 3 multiply-adds.
-[[gnu::always_inline]] inline __m256 invSqrt8(__m256 x) {
-#ifdef __AVX512VL__
-  const __m256 y = _mm256_rsqrt14_ps(x);
-#else
-  const __m256 y = _mm256_rsqrt_ps(x);
-#endif
-  // y (1.5 - 0.5 x y^2), x y first: nothing overflows at FLT_MAX.
-  const __m256 halfXy = _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5f), x), y);
-  return _mm256_mul_ps(y, _mm256_fnmadd_ps(halfXy, y, _mm256_set1_ps(1.5f)));
-}
-
 // The opacities of the eight samples in lane order (quad j holds samples j
 // and j + 4, kernel_batch_over.h).
 [[gnu::always_inline]] inline __m256 alphaLanes(const Quads& c) {
@@ -179,7 +161,7 @@ template <typename T>
   const __m256 gg = _mm256_fmadd_ps(g[2], g[2], _mm256_fmadd_ps(g[1], g[1], _mm256_mul_ps(g[0], g[0])));
   const __m256 lighted = _mm256_and_ps(_mm256_cmp_ps(gg, _mm256_set1_ps(1e-20f), _CMP_GT_OQ),
                                        _mm256_cmp_ps(gg, _mm256_set1_ps(FLT_MAX), _CMP_LE_OQ));
-  const __m256 inv = invSqrt8(gg);
+  const __m256 inv = _mm256_div_ps(_mm256_set1_ps(1.0f), _mm256_sqrt_ps(gg));
   auto dot = [&](const float* w) __attribute__((always_inline)) {
     const __m256 d = _mm256_fmadd_ps(g[2], _mm256_set1_ps(w[2]),
                                      _mm256_fmadd_ps(g[1], _mm256_set1_ps(w[1]), _mm256_mul_ps(g[0], _mm256_set1_ps(w[0]))));

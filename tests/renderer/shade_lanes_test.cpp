@@ -135,33 +135,6 @@ TEST_CASE("the vector gradient equals the scalar gradient", "[raycast]") {
   }
 }
 
-// Identity: invSqrt8() (estimate and one Newton step) is 1 / std::sqrt()
-// to a relative 4e-7 (a few float ulps) over the range the lighting takes
-// it (1e-20 to FLT_MAX), at every binary exponent and at the ends.
-TEST_CASE("the vector inverse square root matches one over the square root", "[raycast]") {
-  std::mt19937 random(5);
-  std::uniform_real_distribution<float> mantissa(1.0f, 2.0f);
-  std::vector<float> at = {1e-20f, std::numeric_limits<float>::max(), 1.0f, 4.0f, 0.25f};
-  for (int e = -66; e < 128; ++e)
-    for (int n = 0; n < 40; ++n) at.push_back(std::ldexp(mantissa(random), e));
-  double worst = 0;
-  for (std::size_t first = 0; first + 8 <= at.size(); first += 8) {
-    alignas(32) float out[8];
-    _mm256_store_ps(out, kernel::invSqrt8(_mm256_loadu_ps(&at[first])));
-    for (int j = 0; j < 8; ++j) {
-      const float x = at[first + j];
-      if (!(x >= 1e-20f)) continue;
-      const float want = 1.0f / std::sqrt(x);
-      const double relative = std::abs(double(out[j]) - double(want)) / double(want);
-      INFO("at " << x << ": " << out[j] << " against " << want);
-      REQUIRE(relative <= 4e-7);
-      worst = std::max(worst, relative);
-    }
-  }
-  INFO("worst relative error " << worst);
-  CHECK(worst > 0);  // the estimate path ran, not the exact one
-}
-
 // Identity: shadeQuads() lights each sample of opacity > 0 as
 // kernel::shade() does and leaves the others as they are, up to float
 // rounding, NaN and infinite voxels around samples included (a non-finite
