@@ -31,6 +31,15 @@ inline constexpr int kLeapBlock = 16;  // coarse block edge, in macrocells
 // holding something visible never needs the coarse bound.
 static_assert(kLeapNear >= kLeapBlock, "a block's own macrocells must be within the exact range");
 
+// Whether `leap` is what leapDistance promises for a macrocell whose exact
+// chessboard distance (capped at 255) is `exact`: equal below kLeapNear;
+// beyond, at least kLeapNear, never more than the truth, and short of it
+// by at most the coarse blocks' slack. For tests and benches.
+constexpr bool leapDistanceFits(int leap, int exact) {
+  return exact < kLeapNear ? leap == exact
+                           : leap >= kLeapNear && leap <= exact && leap >= exact - 2 * (kLeapBlock - 1);
+}
+
 // In place over count.x * count.y * count.z bytes (x fastest): on entry 0
 // marks a visible macrocell and anything else an empty one; on return each
 // holds a distance to the nearest visible macrocell that is exact when
