@@ -11,7 +11,6 @@
 #include "data_summary.h"
 #include "decompose/content.h"
 #include "io/data_directory.h"
-#include "preprocess.h"
 #include "scene_bricks.h"
 #include "scene_volume.h"
 #include "transfer.h"
