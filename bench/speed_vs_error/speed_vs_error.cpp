@@ -9,10 +9,13 @@
 //       per second (total and per thread) and RMSE / PSNR / max abs error of
 //       linear premultiplied RGBA against the scene's reference. Prints a
 //       table and writes CSV.
-//   speed_vs_error --quick SCENE.json [--orbit K]
+//   speed_vs_error --quick SCENE.json [--orbit K] [--step S]
 //       The scene at its own settings only, the same figures, for scripts/demo.
 //       --orbit K times K frames turning the camera 5 degrees each about its
 //       view-up, the camera path of the VTK peer benchmark.
+//       --step S renders at S voxels instead of the scene's own step, so a
+//       faster, coarser setting is timed beside its error (issue 13 compares
+//       speeds "at no larger error" than the peer's).
 //       --peer-png FILE compares another renderer's 8-bit RGB frame of the
 //       scene's own view (VTK's PNG, over black, at the reference's size:
 //       pass --error-size to match) with the same reference, beside ours
@@ -74,6 +77,7 @@ struct Args {
   std::vector<double> steps{2, 1, 0.5, 0.25, 0.125};
   std::vector<double> quality;  // target PSNRs, dB
   int threads = 2, frames = 5, orbit = 0;
+  double quickStep = 0;  // --quick --step: voxels instead of the scene's own step (0 = its own)
   double caseSeconds = 0;  // sweep: stop timing a case after this long (0 = never)
   bench::ReferenceSettings reference{256, 64, 16, PVR_BENCH_CACHE};
   std::string csv = std::string(PVR_SOURCE_DIR) + "/bench/results/speed_vs_error.csv";
@@ -85,7 +89,8 @@ struct Args {
                "usage: speed_vs_error [--threads N] [--frames N] [--error-size N] [--substeps N]\n"
                "                      [--steps A,B,...] [--quality DB,DB,...] [--case-seconds S] [--csv PATH]\n"
                "                      [--cache DIR | --no-cache] [SCENE.json ...]\n"
-               "       speed_vs_error --quick SCENE.json [--orbit K] [--peer-png FILE [--peer-model SCENE.json]] [same options]\n",
+               "       speed_vs_error --quick SCENE.json [--orbit K] [--step S] [--peer-png FILE [--peer-model SCENE.json]]\n"
+               "                      [same options]\n",
                why.c_str());
   std::exit(2);
 }
@@ -122,6 +127,7 @@ Args parseArgs(int argc, char** argv) {
       else if (arg == "--orbit") a.orbit = positive(value());
       else if (arg == "--peer-png") a.peerPng = value();
       else if (arg == "--peer-model") a.peerModel = value();
+      else if (arg == "--step") a.quickStep = parseList(arg, value()).at(0);
       else if (arg == "--case-seconds") a.caseSeconds = std::stod(value());
       else if (arg == "--error-size") a.reference.maxEdge = positive(value());
       else if (arg == "--substeps") a.reference.substeps = positive(value());
@@ -138,6 +144,7 @@ Args parseArgs(int argc, char** argv) {
   }
   if (!a.quick.empty() && !a.scenes.empty()) usage("--quick takes one scene; no other scene files");
   if (a.quick.empty() && a.orbit > 0) usage("--orbit goes with --quick");
+  if (a.quick.empty() && a.quickStep > 0) usage("--step goes with --quick (the sweep takes --steps)");
   if (a.quick.empty() && !a.peerPng.empty()) usage("--peer-png goes with --quick");
   if (a.peerPng.empty() && !a.peerModel.empty()) usage("--peer-model goes with --peer-png");
   if (a.scenes.empty())
@@ -172,7 +179,8 @@ int runQuick(const Args& args) {
   core::ThreadPool pool(args.threads);
   const BenchScene scene(args.quick);
   const core::Scene& s = scene.scene();
-  const Case c = bench::ownCase(s);
+  Case c = bench::ownCase(s);
+  if (args.quickStep > 0) c.step = args.quickStep * scene.voxel();
   std::printf("%s: %s, %dx%d, step %.3g voxel, %s, skipping on, %s, %d threads\n",
               args.quick.c_str(), scene.describe().c_str(), s.image.width, s.image.height,
               c.step / scene.voxel(), c.preintegrated ? "pre-integrated" : "plain",
