@@ -6,8 +6,9 @@
 // instructions. Voxels are fetched with scalar loads (this machine's
 // hardware gathers cost ~19 cycles each, slower than loads). Plain
 // classification and compositing take the eight samples together as well
-// (kernel_batch_over.h); the pre-integrated batch composites its segments
-// one at a time, in the same order and precision as the scalar loop.
+// (kernel_batch_over.h), and so do the pre-integrated batch's eight
+// segments, lit (shade_lanes.h) eight at a time, unless one is opaque: then
+// they are composited one at a time, in the scalar loop's order and precision.
 #pragma once
 
 #if defined(__AVX2__) && defined(__FMA__)
@@ -171,6 +172,22 @@ template <typename T>
   q.q[3] = _mm256_shuffle_ps(rgHigh, baHigh, 0xEE);
   return q;
 }
+
+// Where shadeSegment() lights segments [s + j, s + j + 1), j = 0..7: the
+// points centre - spread and centre + spread of each (clamped into the
+// segment), as index-space positions u[0] (front) and u[1] (back), the
+// position formula of shadeSegment() with fused multiply-adds.
+[[gnu::always_inline]] inline void litPoints8(const __m256 o[3], const __m256 d[3],
+                                              std::int64_t s, const preint::Segments8& seg, __m256 u[2][3]) {
+  const __m256 centre = _mm512_maskz_cvtpd_ps(preint::kAll, seg.centre);
+  const __m256 spread = _mm512_maskz_cvtpd_ps(preint::kAll, seg.spread);
+  const __m256 lane = _mm256_add_ps(_mm256_set1_ps(float(s)), _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7));
+  const __m256 t[2] = {
+      _mm256_add_ps(lane, _mm256_max_ps(_mm256_sub_ps(centre, spread), _mm256_setzero_ps())),
+      _mm256_add_ps(lane, _mm256_min_ps(_mm256_add_ps(centre, spread), _mm256_set1_ps(1.0f)))};
+  for (int e = 0; e < 2; ++e)
+    for (int a = 0; a < 3; ++a) u[e][a] = _mm256_fmadd_ps(t[e], d[a], o[a]);
+}
 #endif
 
 // Pre-integrated segments [s, s + 1) for s in [start, exit), eight at a
@@ -287,13 +304,28 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     const preint::Ends8 backs = preint::endsAt(p.preint, node);
     const preint::Ends8 fronts = preint::fronts(before, backs);
     const preint::Segments8 seg = preint::segments<kShaded>(fronts, backs, p.stepLength);
-    if (!kShaded && !seg.opaque) {
-      // Unlit and with no opaque segment (those take the loop below), the
-      // eight segments are composited with each other as plain samples are
+    if (!seg.opaque) {
+      // With no opaque segment (those take the loop below), the eight
+      // segments are composited with each other as plain samples are
       // (kernel_batch_over.h), then into the ray: one link of the "over"
       // chain per batch instead of eight.
+      Quads batch = segmentQuads(seg, __mmask8(valid));
+      if constexpr (kShaded) {
+        // Lit: the eight segments' two lighting points (shadeSegment()) lit
+        // as two batches of eight samples (shade_lanes.h) and the two
+        // colours averaged (the opacities are the unlit ones in both, so
+        // stay exact). Lit one lane at a time, each point's gradient read
+        // its 32 nodes with scalar loads: about 40 % of a shaded frame.
+        __m256 u[2][3];
+        litPoints8(o, d, s, seg, u);
+        Quads back = batch;
+        shadeQuads(v, p, ray, u[0], batch);
+        shadeQuads(v, p, ray, u[1], back);
+        for (int j = 0; j < 4; ++j)
+          batch.q[j] = _mm256_mul_ps(_mm256_add_ps(batch.q[j], back.q[j]), _mm256_set1_ps(0.5f));
+      }
       __m256d gathered = _mm256_setr_pd(acc.r, acc.g, acc.b, acc.a);
-      gathered = addBehind4(gathered, overQuads(segmentQuads(seg, __mmask8(valid))));
+      gathered = addBehind4(gathered, overQuads(batch));
       alignas(32) double out[4];
       _mm256_store_pd(out, gathered);
       acc = {out[0], out[1], out[2], out[3]};
