@@ -170,8 +170,10 @@ template <typename T, bool kShaded, bool kPreintegrated>
 class RayWalk {
  public:
   // Sets the walk up; false when the ray is done already (out holds its
-  // result: no sample here, a short chord, or no visible macrocell).
-  bool start(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
+  // result: no sample here, a short chord, or no visible macrocell). The
+  // ray's samples before `from` are known to lie in invisible macrocells
+  // (tileStart(), tile_start.h): the walk starts at it.
+  bool start(const KernelParams& p, const RaySetup& ray, int mcShift, std::int64_t from, RayResult& out) {
     if (!sampleRange(p, ray, first_, last_)) {
       // No sample here; the ray may still cross the domain between two samples.
       double kIn, kOut;
@@ -194,6 +196,8 @@ class RayWalk {
     k_ = first_;
     end_ = last_;
     if (!clipToVisible(p, ray, k_, end_)) return false;
+    k_ = std::max(k_, from);
+    if (k_ > end_) return false;
     ends_ = chordEnds(p, ray, first_, last_);
     for (int a = 0; a < 3; ++a) {
       o_[a] = float(ray.origin[a]);
@@ -243,26 +247,29 @@ class RayWalk {
 
 }  // namespace kernel
 
+// One ray; its samples before `from` lie in invisible macrocells
+// (tileStart(), tile_start.h; 0: nothing known).
 template <typename T, bool kShaded, bool kPreintegrated>
-RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
+RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift, std::int64_t from = 0) {
   RayResult out;
   kernel::RayWalk<T, kShaded, kPreintegrated> walk;
-  if (walk.start(p, ray, mcShift, out))
+  if (walk.start(p, ray, mcShift, from, out))
     while (walk.step(p, ray, mcShift, out)) {
     }
   return out;
 }
 
 // Rays rays[0, n) into out[0, n), n <= kRaysAtOnce: their walks by
-// turns, a step of each (see RayWalk), each ray as castRay would take it.
+// turns, a step of each (see RayWalk), each ray as castRay would take it
+// (with the same `from`).
 template <typename T, bool kShaded, bool kPreintegrated>
-void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, RayResult* out) {
+void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, std::int64_t from, RayResult* out) {
   kernel::RayWalk<T, kShaded, kPreintegrated> walk[kRaysAtOnce];
   bool going[kRaysAtOnce];
   int left = 0;
   for (int i = 0; i < n; ++i) {
     out[i] = RayResult{};
-    going[i] = walk[i].start(p, rays[i], mcShift, out[i]);
+    going[i] = walk[i].start(p, rays[i], mcShift, from, out[i]);
     left += going[i];
   }
   while (left > 0) {
