@@ -148,14 +148,14 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
 // visible; else past the empty cube around it that the distance field
 // proves (emptyExit). o and d: the ray's origin and step in float, as the
 // samples'.
-[[gnu::always_inline]] inline std::int64_t pastEmpty(const KernelParams& p, const RaySetup& ray, const float* o,
+[[gnu::always_inline]] inline std::int64_t pastEmpty(const KernelParams& p, const CubeExit& cube, const float* o,
                                                      const float* d, std::int64_t k, int mcShift) {
   int m[3];
   for (int a = 0; a < 3; ++a)
     m[a] = std::clamp(int(o[a] + float(k) * d[a]) >> mcShift, p.mcFirst[a], p.mcFirst[a] + p.mcCount[a] - 1);
   const int distance = p.distance[macrocellIndex(p, m)];
   if (distance == 0) return k;
-  return emptyExit(ray, m, distance, k, mcShift);
+  return cube.exit(m, distance, k);
 }
 
 }  // namespace kernel
@@ -205,13 +205,14 @@ class RayWalk {
     }
     done_ = first_;
     chunk_ = visibleChunk(ray);
+    cube_ = CubeExit(ray, mcShift);
     return true;
   }
 
   // One look-up, and a chunk of samples where it finds something visible.
   // False when the ray is done (out holds its result).
   bool step(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
-    if (const std::int64_t next = pastEmpty(p, ray, o_, d_, k_, mcShift); next != k_) {
+    if (const std::int64_t next = pastEmpty(p, cube_, o_, d_, k_, mcShift); next != k_) {
       k_ = next;
       return k_ <= end_ || finish(out);
     }
@@ -241,6 +242,7 @@ class RayWalk {
   std::int64_t done_ = 0;               // next sample not yet composited or skipped
   std::int64_t chunk_ = 0;
   ChordEnds ends_;
+  CubeExit cube_;
   float o_[3], d_[3];  // the ray's origin and step in float, as the samples'
   Accumulator acc_;
 };
