@@ -7,6 +7,7 @@
 #include "kernel.h"
 #include "kernel_batch.h"
 #include "preint_lighting.h"
+#include "tile_start.h"
 
 namespace pvr::core {
 
@@ -171,9 +172,9 @@ class RayWalk {
  public:
   // Sets the walk up; false when the ray is done already (out holds its
   // result: no sample here, a short chord, or no visible macrocell). The
-  // ray's samples before `from` are known to lie in invisible macrocells
-  // (tileStart(), tile_start.h): the walk starts at it.
-  bool start(const KernelParams& p, const RaySetup& ray, int mcShift, std::int64_t from, RayResult& out) {
+  // ray's samples outside `span` are known to lie in invisible macrocells
+  // (tileSpan(), tile_start.h): the walk starts and ends within it.
+  bool start(const KernelParams& p, const RaySetup& ray, int mcShift, const TileSpan& span, RayResult& out) {
     if (!sampleRange(p, ray, first_, last_)) {
       // No sample here; the ray may still cross the domain between two samples.
       double kIn, kOut;
@@ -196,7 +197,8 @@ class RayWalk {
     k_ = first_;
     end_ = last_;
     if (!clipToVisible(p, ray, k_, end_)) return false;
-    k_ = std::max(k_, from);
+    k_ = std::max(k_, span.from);
+    end_ = std::min(end_, span.to);
     if (k_ > end_) return false;
     ends_ = chordEnds(p, ray, first_, last_);
     for (int a = 0; a < 3; ++a) {
@@ -249,13 +251,13 @@ class RayWalk {
 
 }  // namespace kernel
 
-// One ray; its samples before `from` lie in invisible macrocells
-// (tileStart(), tile_start.h; 0: nothing known).
+// One ray; its samples outside `span` lie in invisible macrocells
+// (tileSpan(), tile_start.h; by default nothing is known).
 template <typename T, bool kShaded, bool kPreintegrated>
-RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift, std::int64_t from = 0) {
+RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift, const kernel::TileSpan& span = {}) {
   RayResult out;
   kernel::RayWalk<T, kShaded, kPreintegrated> walk;
-  if (walk.start(p, ray, mcShift, from, out))
+  if (walk.start(p, ray, mcShift, span, out))
     while (walk.step(p, ray, mcShift, out)) {
     }
   return out;
@@ -263,15 +265,16 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift, std::
 
 // Rays rays[0, n) into out[0, n), n <= kRaysAtOnce: their walks by
 // turns, a step of each (see RayWalk), each ray as castRay would take it
-// (with the same `from`).
+// (with the same `span`).
 template <typename T, bool kShaded, bool kPreintegrated>
-void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, std::int64_t from, RayResult* out) {
+void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan& span,
+              RayResult* out) {
   kernel::RayWalk<T, kShaded, kPreintegrated> walk[kRaysAtOnce];
   bool going[kRaysAtOnce];
   int left = 0;
   for (int i = 0; i < n; ++i) {
     out[i] = RayResult{};
-    going[i] = walk[i].start(p, rays[i], mcShift, from, out[i]);
+    going[i] = walk[i].start(p, rays[i], mcShift, span, out[i]);
     left += going[i];
   }
   while (left > 0) {

@@ -17,9 +17,9 @@ namespace pvr::core {
 
 namespace {
 
-// Casts rays[0, n) into out[0, n), n <= kRaysAtOnce, whose samples before
-// `from` lie in invisible macrocells (tileStart()).
-using RayFunction = void (*)(const KernelParams&, const RaySetup*, int, int, std::int64_t, RayResult*);
+// Casts rays[0, n) into out[0, n), n <= kRaysAtOnce, whose samples outside
+// the span lie in invisible macrocells (tileSpan()).
+using RayFunction = void (*)(const KernelParams&, const RaySetup*, int, int, const kernel::TileSpan&, RayResult*);
 
 // The one place configuration picks a kernel instantiation.
 template <typename T>
@@ -28,10 +28,11 @@ RayFunction pickKernel(bool shaded, bool preintegrated) {
   return preintegrated ? &castRays<T, false, true> : &castRays<T, false, false>;
 }
 
-// A kernel of one ray at a time as a RayFunction (that walks from each
-// ray's start: `from` only saves look-ups).
+// A kernel of one ray at a time as a RayFunction (that walks each ray
+// whole: the span only saves look-ups).
 template <RayResult (*kCast)(const KernelParams&, const RaySetup&, int)>
-void oneByOne(const KernelParams& p, const RaySetup* rays, int n, int mcShift, std::int64_t, RayResult* out) {
+void oneByOne(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan&,
+              RayResult* out) {
   for (int i = 0; i < n; ++i) out[i] = kCast(p, rays[i], mcShift);
 }
 
@@ -148,12 +149,12 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   const Vec3 lightWorld = normalize(camera.toWorld(options.shading.lightDirection));
 
   // Tiles of the rectangle over the pool; each worker counts its own work.
-  // A tile's rays are set up together, and where they can first meet a
-  // visible macrocell found once for all of them (tile_start.h).
+  // A tile's rays are set up together, and where they can first and last
+  // meet a visible macrocell found once for all of them (tile_start.h).
   struct TileRays {
     RaySetup rays[kTileSize * kTileSize];
     int x0 = 0, y0 = 0, width = 0;
-    std::int64_t from = 0;
+    kernel::TileSpan span;
   };
   RenderStats counted;
   renderTileRuns<TileRays>(
@@ -165,10 +166,10 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
         int n = 0;
         for (int y = y0; y < y1; ++y)
           for (int x = x0; x < x1; ++x) tile.rays[n++] = raySetup(camera.ray(x, y), grid, step, lightWorld);
-        tile.from = kernel::tileStart(p, tile.rays, n, MacrocellGrid::kShift);
+        tile.span = kernel::tileSpan(p, tile.rays, n, MacrocellGrid::kShift);
       },
       [&](const TileRays& tile, int x, int y, int n, RayResult* out) {
-        cast(p, &tile.rays[(y - tile.y0) * tile.width + (x - tile.x0)], n, MacrocellGrid::kShift, tile.from, out);
+        cast(p, &tile.rays[(y - tile.y0) * tile.width + (x - tile.x0)], n, MacrocellGrid::kShift, tile.span, out);
       },
       counted);
   if (stats) {

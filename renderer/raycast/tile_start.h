@@ -1,5 +1,5 @@
-// Where a tile's rays can first meet a visible macrocell, found once for
-// the whole tile.
+// Where a tile's rays can first and last meet a visible macrocell, found
+// once for the whole tile.
 //
 // Every ray walks the empty space in front of what it meets a look-up at a
 // time (cast_ray.h, RayWalk); before its first visible macrocell the walks
@@ -9,7 +9,9 @@
 // that box is marched through the distance field: while the empty cube a
 // macrocell's distance proves (kernel::emptyExit) holds the whole box, no
 // ray of the tile meets anything visible, so each may start its own walk
-// past it. It only decides which samples in invisible macrocells the rays
+// past it; marched backwards from the far side of the visible box, it
+// ends the rays' walks before the empty space behind the last thing they
+// can meet. It only decides which samples in invisible macrocells the rays
 // skip, so the image is unchanged beyond rounding.
 #pragma once
 
@@ -63,28 +65,15 @@ inline FatRay fatRay(const RaySetup* rays, int n) {
   return f;
 }
 
-// At most this many look-ups per tile: the march stops early once the fat
-// ray comes near something visible.
+// At most this many look-ups per march: it stops early once the fat ray
+// comes near something visible.
 inline constexpr int kTileMarchLookups = 32;
 
-// A sample index before which no sample of rays[0, n) lies in a visible
-// macrocell of the brick (in the visible box, KernelParams::visibleLo, or
-// in the empty cube of some macrocell's distance): each ray may start its
-// walk there. 0 when nothing is proven; past every ray's last sample in
-// the visible box when none of them meets anything visible.
-inline std::int64_t tileStart(const KernelParams& p, const RaySetup* rays, int n, int mcShift) {
-  if (n <= 0) return 0;
-  const FatRay f = fatRay(rays, n);
-  // Where the fat ray can touch the visible box: [lo, hi].
-  double lo = 0, hi = 1e18;
-  for (int a = 0; a < 3; ++a) {
-    if (!(p.visibleLo[a] <= p.visibleHi[a])) return 0;  // nothing visible: clipToVisible ends every ray
-    keepWhereNonNegative(f.centre0[a] + f.radius0[a] - p.visibleLo[a], f.centreStep[a] + f.radiusPerStep[a], lo, hi);
-    keepWhereNonNegative(p.visibleHi[a] - f.centre0[a] + f.radius0[a], f.radiusPerStep[a] - f.centreStep[a], lo, hi);
-  }
-  if (!(lo <= hi)) return std::int64_t(1e18);  // no ray of the tile meets the visible box
-  // March: from k on, the box holds [k, reached]'s samples.
-  double k = lo;
+// How far f can go from k = start towards k = limit > start within empty
+// cubes: every position of every ray of f with k in [start, result] lies
+// in an invisible macrocell or outside the brick's macrocells.
+inline double marchEmpty(const KernelParams& p, const FatRay& f, double start, double limit, int mcShift) {
+  double k = start;
   const double size = double(std::int64_t(1) << mcShift);
   for (int lookups = 0; lookups < kTileMarchLookups; ++lookups) {
     int m[3];
@@ -96,8 +85,8 @@ inline std::int64_t tileStart(const KernelParams& p, const RaySetup* rays, int n
     if (distance == 0) break;
     // The cube of macrocells within distance - 1 of m holds only invisible
     // ones; positions in [cubeLo, cubeHi) per axis lie in it or outside the
-    // brick's macrocells.
-    double from = k, reached = hi;
+    // brick's macrocells (the radius' slack keeps the samples off cubeHi).
+    double from = k, reached = limit;
     for (int a = 0; a < 3; ++a) {
       const double cubeLo = double(m[a] - distance + 1) * size, cubeHi = double(m[a] + distance) * size;
       // centre - radius >= cubeLo and centre + radius <= cubeHi.
@@ -106,9 +95,46 @@ inline std::int64_t tileStart(const KernelParams& p, const RaySetup* rays, int n
     }
     if (from > k || reached < k + 0.5) break;  // the box does not fit the cube here, or hardly moves on
     k = reached;
-    if (k >= hi) return std::int64_t(std::floor(std::min(hi, 1e18))) + 1;  // nothing visible on any ray
+    if (k >= limit) return limit;
   }
-  return std::int64_t(std::floor(k));
+  return k;
+}
+
+// The samples of a tile's rays that may lie in a visible macrocell: each
+// ray's samples before `from` and after `to` lie in invisible ones.
+struct TileSpan {
+  std::int64_t from = 0;
+  std::int64_t to = std::int64_t(1e18);
+};
+
+// The span of rays[0, n), from marches of their fat ray through the
+// distance field inwards from both ends of where it crosses the visible
+// box (KernelParams::visibleLo): each ray may start its walk at `from` and
+// end it at `to`. Empty (from > to) when no ray meets anything visible.
+inline TileSpan tileSpan(const KernelParams& p, const RaySetup* rays, int n, int mcShift) {
+  TileSpan span;
+  if (n <= 0) return span;
+  const FatRay f = fatRay(rays, n);
+  // Where the fat ray can touch the visible box: [lo, hi].
+  double lo = 0, hi = 1e18;
+  for (int a = 0; a < 3; ++a) {
+    if (!(p.visibleLo[a] <= p.visibleHi[a])) return span;  // nothing visible: clipToVisible ends every ray
+    keepWhereNonNegative(f.centre0[a] + f.radius0[a] - p.visibleLo[a], f.centreStep[a] + f.radiusPerStep[a], lo, hi);
+    keepWhereNonNegative(p.visibleHi[a] - f.centre0[a] + f.radius0[a], f.radiusPerStep[a] - f.centreStep[a], lo, hi);
+  }
+  if (!(lo <= hi)) return {1, 0};  // no ray of the tile meets the visible box
+  const double in = marchEmpty(p, f, lo, hi, mcShift);
+  if (in >= hi) return {1, 0};  // nothing visible on any ray
+  // Backwards from hi: the same fat ray in k' = -k.
+  FatRay back = f;
+  for (int a = 0; a < 3; ++a) {
+    back.centreStep[a] = -f.centreStep[a];
+    back.radiusPerStep[a] = -f.radiusPerStep[a];  // radius0 - k' radiusPerStep, for k' <= 0
+  }
+  const double out = -marchEmpty(p, back, -hi, -in, mcShift);
+  span.from = std::int64_t(std::floor(in));
+  span.to = std::int64_t(std::ceil(std::min(out, 1e18)));
+  return span;
 }
 
 }  // namespace pvr::core::kernel
