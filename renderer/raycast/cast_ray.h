@@ -7,6 +7,7 @@
 #include "kernel.h"
 #include "kernel_batch.h"
 #include "preint_lighting.h"
+#include "tile_start.h"
 
 namespace pvr::core {
 
@@ -148,14 +149,14 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
 // visible; else past the empty cube around it that the distance field
 // proves (emptyExit). o and d: the ray's origin and step in float, as the
 // samples'.
-[[gnu::always_inline]] inline std::int64_t pastEmpty(const KernelParams& p, const RaySetup& ray, const float* o,
+[[gnu::always_inline]] inline std::int64_t pastEmpty(const KernelParams& p, const CubeExit& cube, const float* o,
                                                      const float* d, std::int64_t k, int mcShift) {
   int m[3];
   for (int a = 0; a < 3; ++a)
     m[a] = std::clamp(int(o[a] + float(k) * d[a]) >> mcShift, p.mcFirst[a], p.mcFirst[a] + p.mcCount[a] - 1);
   const int distance = p.distance[macrocellIndex(p, m)];
   if (distance == 0) return k;
-  return emptyExit(ray, m, distance, k, mcShift);
+  return cube.exit(m, distance, k);
 }
 
 }  // namespace kernel
@@ -170,8 +171,10 @@ template <typename T, bool kShaded, bool kPreintegrated>
 class RayWalk {
  public:
   // Sets the walk up; false when the ray is done already (out holds its
-  // result: no sample here, a short chord, or no visible macrocell).
-  bool start(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
+  // result: no sample here, a short chord, or no visible macrocell). The
+  // ray's samples outside `span` are known to lie in invisible macrocells
+  // (tileSpan(), tile_start.h): the walk starts and ends within it.
+  bool start(const KernelParams& p, const RaySetup& ray, int mcShift, const TileSpan& span, RayResult& out) {
     if (!sampleRange(p, ray, first_, last_)) {
       // No sample here; the ray may still cross the domain between two samples.
       double kIn, kOut;
@@ -194,6 +197,9 @@ class RayWalk {
     k_ = first_;
     end_ = last_;
     if (!clipToVisible(p, ray, k_, end_)) return false;
+    k_ = std::max(k_, span.from);
+    end_ = std::min(end_, span.to);
+    if (k_ > end_) return false;
     ends_ = chordEnds(p, ray, first_, last_);
     for (int a = 0; a < 3; ++a) {
       o_[a] = float(ray.origin[a]);
@@ -201,13 +207,14 @@ class RayWalk {
     }
     done_ = first_;
     chunk_ = visibleChunk(ray);
+    cube_ = CubeExit(ray, mcShift);
     return true;
   }
 
   // One look-up, and a chunk of samples where it finds something visible.
   // False when the ray is done (out holds its result).
   bool step(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
-    if (const std::int64_t next = pastEmpty(p, ray, o_, d_, k_, mcShift); next != k_) {
+    if (const std::int64_t next = pastEmpty(p, cube_, o_, d_, k_, mcShift); next != k_) {
       k_ = next;
       return k_ <= end_ || finish(out);
     }
@@ -237,32 +244,37 @@ class RayWalk {
   std::int64_t done_ = 0;               // next sample not yet composited or skipped
   std::int64_t chunk_ = 0;
   ChordEnds ends_;
+  CubeExit cube_;
   float o_[3], d_[3];  // the ray's origin and step in float, as the samples'
   Accumulator acc_;
 };
 
 }  // namespace kernel
 
+// One ray; its samples outside `span` lie in invisible macrocells
+// (tileSpan(), tile_start.h; by default nothing is known).
 template <typename T, bool kShaded, bool kPreintegrated>
-RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift) {
+RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift, const kernel::TileSpan& span = {}) {
   RayResult out;
   kernel::RayWalk<T, kShaded, kPreintegrated> walk;
-  if (walk.start(p, ray, mcShift, out))
+  if (walk.start(p, ray, mcShift, span, out))
     while (walk.step(p, ray, mcShift, out)) {
     }
   return out;
 }
 
 // Rays rays[0, n) into out[0, n), n <= kRaysAtOnce: their walks by
-// turns, a step of each (see RayWalk), each ray as castRay would take it.
+// turns, a step of each (see RayWalk), each ray as castRay would take it
+// (with the same `span`).
 template <typename T, bool kShaded, bool kPreintegrated>
-void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, RayResult* out) {
+void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan& span,
+              RayResult* out) {
   kernel::RayWalk<T, kShaded, kPreintegrated> walk[kRaysAtOnce];
   bool going[kRaysAtOnce];
   int left = 0;
   for (int i = 0; i < n; ++i) {
     out[i] = RayResult{};
-    going[i] = walk[i].start(p, rays[i], mcShift, out[i]);
+    going[i] = walk[i].start(p, rays[i], mcShift, span, out[i]);
     left += going[i];
   }
   while (left > 0) {

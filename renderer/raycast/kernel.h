@@ -341,16 +341,16 @@ inline bool sampleRange(const KernelParams& p, const RaySetup& r, std::int64_t& 
       if (r.origin[a] < p.ownLo[a] || r.origin[a] > p.ownHi[a]) return false;
       continue;
     }
-    double k0 = (p.ownLo[a] - r.origin[a]) / r.step[a];
-    double k1 = (p.ownHi[a] - r.origin[a]) / r.step[a];
+    double k0 = (p.ownLo[a] - r.origin[a]) * r.invStep[a];
+    double k1 = (p.ownHi[a] - r.origin[a]) * r.invStep[a];
     if (k0 > k1) std::swap(k0, k1);
     kmin = std::max(kmin, k0);
     kmax = std::min(kmax, k1);
   }
   if (kmin > kmax + 2) return false;
-  // The estimate is within a sample or two; the exact test decides.
-  first = std::max<std::int64_t>(0, std::int64_t(std::ceil(kmin)) - 2);
-  last = std::int64_t(std::floor(kmax)) + 2;
+  // The estimate is within a sample (rounding); the exact test decides.
+  first = std::max<std::int64_t>(0, std::int64_t(std::ceil(kmin)) - 1);
+  last = std::int64_t(std::floor(kmax)) + 1;
   while (first <= last && !inside(p, r, first)) ++first;
   if (first > last) return false;
   while (!inside(p, r, last)) --last;
@@ -414,8 +414,8 @@ inline bool domainChord(const KernelParams& p, const RaySetup& r, double& kIn, d
       if (!(r.origin[a] >= 0.0 && r.origin[a] <= double(p.domainMax[a]))) return false;
       continue;
     }
-    double k0 = -r.origin[a] / r.step[a];
-    double k1 = (double(p.domainMax[a]) - r.origin[a]) / r.step[a];
+    double k0 = -r.origin[a] * r.invStep[a];
+    double k1 = (double(p.domainMax[a]) - r.origin[a]) * r.invStep[a];
     if (k0 > k1) std::swap(k0, k1);
     kIn = std::max(kIn, k0);
     kOut = std::min(kOut, k1);
@@ -488,17 +488,37 @@ inline std::int64_t visibleChunk(const RaySetup& r) { return r.leapPerMacrocell 
 // least distance - 1 macrocells further along every axis, so this leaps at
 // least as far as distance - 1 macrocells along the major axis would, and
 // the rest of m and the cube's reach along the minor axes besides, with no
-// branch on the distance.
-inline std::int64_t emptyExit(const RaySetup& r, const int m[3], int distance, std::int64_t k, int shift) {
-  double exitK = 1e300;
-  for (int a = 0; a < 3; ++a) {
-    if (r.step[a] > 0)
-      exitK = std::min(exitK, (double(std::int64_t(m[a] + distance) << shift) - r.origin[a]) * r.invStep[a]);
-    else if (r.step[a] < 0)
-      exitK = std::min(exitK, (double(std::int64_t(m[a] - distance + 1) * (std::int64_t(1) << shift)) - r.origin[a]) *
-                                  r.invStep[a]);
+// branch on the distance. Set up once per ray: each leap is then three
+// multiply-adds and a minimum, with no branch on the ray's direction (a
+// ray's walk takes one per empty look-up).
+class CubeExit {
+ public:
+  CubeExit() = default;
+  CubeExit(const RaySetup& r, int shift) {
+    const double size = double(std::int64_t(1) << shift);
+    for (int a = 0; a < 3; ++a) {
+      // The face the ray leaves by, in steps: (m + d) size going up,
+      // (m - d + 1) size going down, as (m + sign d) scale + base.
+      sign_[a] = r.step[a] > 0 ? 1 : r.step[a] < 0 ? -1 : 0;
+      scale_[a] = sign_[a] != 0 ? size * r.invStep[a] : 0.0;
+      base_[a] = r.step[a] > 0 ? -r.origin[a] * r.invStep[a]
+                 : r.step[a] < 0 ? (size - r.origin[a]) * r.invStep[a]
+                                 : 1e300;
+    }
   }
-  return std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(std::min(exitK, 1e18))));
+  std::int64_t exit(const int m[3], int distance, std::int64_t k) const {
+    double exitK = 1e300;
+    for (int a = 0; a < 3; ++a) exitK = std::min(exitK, double(m[a] + sign_[a] * distance) * scale_[a] + base_[a]);
+    return std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(std::min(exitK, 1e18))));
+  }
+
+ private:
+  double scale_[3] = {0, 0, 0}, base_[3] = {1e300, 1e300, 1e300};
+  int sign_[3] = {0, 0, 0};
+};
+
+inline std::int64_t emptyExit(const RaySetup& r, const int m[3], int distance, std::int64_t k, int shift) {
+  return CubeExit(r, shift).exit(m, distance, k);
 }
 
 }  // namespace kernel

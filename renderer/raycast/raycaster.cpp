@@ -10,14 +10,16 @@
 #include "cast_ray.h"
 #include "cast_ray_levels.h"
 #include "kernel_setup.h"
+#include "tile_start.h"
 #include "tiles.h"
 
 namespace pvr::core {
 
 namespace {
 
-// Casts rays[0, n) into out[0, n), n <= kRaysAtOnce.
-using RayFunction = void (*)(const KernelParams&, const RaySetup*, int, int, RayResult*);
+// Casts rays[0, n) into out[0, n), n <= kRaysAtOnce, whose samples outside
+// the span lie in invisible macrocells (tileSpan()).
+using RayFunction = void (*)(const KernelParams&, const RaySetup*, int, int, const kernel::TileSpan&, RayResult*);
 
 // The one place configuration picks a kernel instantiation.
 template <typename T>
@@ -26,9 +28,11 @@ RayFunction pickKernel(bool shaded, bool preintegrated) {
   return preintegrated ? &castRays<T, false, true> : &castRays<T, false, false>;
 }
 
-// A kernel of one ray at a time as a RayFunction.
+// A kernel of one ray at a time as a RayFunction (that walks each ray
+// whole: the span only saves look-ups).
 template <RayResult (*kCast)(const KernelParams&, const RaySetup&, int)>
-void oneByOne(const KernelParams& p, const RaySetup* rays, int n, int mcShift, RayResult* out) {
+void oneByOne(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan&,
+              RayResult* out) {
   for (int i = 0; i < n; ++i) out[i] = kCast(p, rays[i], mcShift);
 }
 
@@ -145,12 +149,29 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   const Vec3 lightWorld = normalize(camera.toWorld(options.shading.lightDirection));
 
   // Tiles of the rectangle over the pool; each worker counts its own work.
+  // A tile's rays are set up together, and where they can first and last
+  // meet a visible macrocell found once for all of them (tile_start.h).
+  struct TileRays {
+    RaySetup rays[kTileSize * kTileSize];
+    int x0 = 0, y0 = 0, width = 0;
+    kernel::TileSpan span;
+  };
   RenderStats counted;
-  renderTileRuns(image, options, pool, [&](int x, int y, int n, RayResult* out) {
-    RaySetup rays[kRaysAtOnce];
-    for (int i = 0; i < n; ++i) rays[i] = raySetup(camera.ray(x + i, y), grid, step, lightWorld);
-    cast(p, rays, n, MacrocellGrid::kShift, out);
-  }, counted);
+  renderTileRuns<TileRays>(
+      image, options, pool,
+      [&](int x0, int y0, int x1, int y1, TileRays& tile) {
+        tile.x0 = x0;
+        tile.y0 = y0;
+        tile.width = x1 - x0;
+        int n = 0;
+        for (int y = y0; y < y1; ++y)
+          for (int x = x0; x < x1; ++x) tile.rays[n++] = raySetup(camera.ray(x, y), grid, step, lightWorld);
+        tile.span = kernel::tileSpan(p, tile.rays, n, MacrocellGrid::kShift);
+      },
+      [&](const TileRays& tile, int x, int y, int n, RayResult* out) {
+        cast(p, &tile.rays[(y - tile.y0) * tile.width + (x - tile.x0)], n, MacrocellGrid::kShift, tile.span, out);
+      },
+      counted);
   if (stats) {
     *stats = counted;
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

@@ -16,14 +16,17 @@ namespace pvr::core {
 
 inline constexpr int kTileSize = 16;
 
-// Calls castRun(x, y, n, out) for runs of n <= kRaysAtOnce pixels (x, y),
-// (x + 1, y), ... of every row of image.rect(), which fills out[0, n), and
-// stores their colours; adds up samples and the rays that hit into
-// `stats` (seconds are the caller's). Throws Error kCancelled once
-// options.stop reads true (tiles not yet started are skipped).
-template <typename CastRun>
-void renderTileRuns(Image& image, const RenderOptions& options, ThreadPool& pool, const CastRun& castRun,
-                    RenderStats& stats) {
+// For each tile [x0, x1) x [y0, y1) of image.rect(), calls
+// beginTile(x0, y0, x1, y1, tile) on a Tile of the worker's own (what the
+// tile's rays share), then castRun(tile, x, y, n, out) for runs of
+// n <= kRaysAtOnce pixels (x, y), (x + 1, y), ... of each of its rows,
+// which fills out[0, n), and stores their colours; adds up samples and the
+// rays that hit into `stats` (seconds are the caller's). Throws Error
+// kCancelled once options.stop reads true (tiles not yet started are
+// skipped).
+template <typename Tile, typename BeginTile, typename CastRun>
+void renderTileRuns(Image& image, const RenderOptions& options, ThreadPool& pool, const BeginTile& beginTile,
+                    const CastRun& castRun, RenderStats& stats) {
   const PixelRect r = image.rect();
   const int tilesX = (r.width() + kTileSize - 1) / kTileSize;
   const int tilesY = (r.height() + kTileSize - 1) / kTileSize;
@@ -35,11 +38,13 @@ void renderTileRuns(Image& image, const RenderOptions& options, ThreadPool& pool
     const int x0 = r.x0 + tx * kTileSize, y0 = r.y0 + ty * kTileSize;
     const int x1 = std::min(r.x1, x0 + kTileSize), y1 = std::min(r.y1, y0 + kTileSize);
     std::uint64_t samples = 0, rays = 0;
+    Tile state;
+    beginTile(x0, y0, x1, y1, state);
     for (int y = y0; y < y1; ++y) {
       for (int x = x0; x < x1; x += kRaysAtOnce) {
         const int n = std::min(kRaysAtOnce, x1 - x);
         RayResult res[kRaysAtOnce];
-        castRun(x, y, n, res);
+        castRun(state, x, y, n, res);
         for (int i = 0; i < n; ++i) {
           image.at(x + i, y) = res[i].colour;
           samples += res[i].samples;
@@ -60,9 +65,13 @@ void renderTileRuns(Image& image, const RenderOptions& options, ThreadPool& pool
 template <typename CastPixel>
 void renderTiles(Image& image, const RenderOptions& options, ThreadPool& pool, const CastPixel& castPixel,
                  RenderStats& stats) {
-  renderTileRuns(image, options, pool, [&](int x, int y, int n, RayResult* out) {
-    for (int i = 0; i < n; ++i) out[i] = castPixel(x + i, y);
-  }, stats);
+  struct NoTile {};
+  renderTileRuns<NoTile>(
+      image, options, pool, [](int, int, int, int, NoTile&) {},
+      [&](NoTile&, int x, int y, int n, RayResult* out) {
+        for (int i = 0; i < n; ++i) out[i] = castPixel(x + i, y);
+      },
+      stats);
 }
 
 }  // namespace pvr::core

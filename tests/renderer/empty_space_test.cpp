@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "raycast/kernel_setup.h"
 #include "raycast/macrocells.h"
 #include "raycast/raycaster.h"
+#include "raycast/tile_start.h"
 #include "reference.h"
 #include "transfer.h"
 
@@ -252,9 +254,9 @@ TEST_CASE("rays cast by turns equal rays cast one at a time", "[raycast]") {
           RaySetup rays[kRaysAtOnce];
           for (int i = 0; i < count; ++i) rays[i] = raySetup(camera.ray(x + i, y), volume.grid(), o.step, light);
           RayResult together[kRaysAtOnce];
-          turns(p, rays, count, MacrocellGrid::kShift, together);
+          turns(p, rays, count, MacrocellGrid::kShift, kernel::TileSpan{}, together);
           for (int i = 0; i < count; ++i) {
-            const RayResult alone = one(p, rays[i], MacrocellGrid::kShift);
+            const RayResult alone = one(p, rays[i], MacrocellGrid::kShift, kernel::TileSpan{});
             INFO("pixel " << x + i << ", " << y);
             CHECK(together[i].hit == alone.hit);
             CHECK(together[i].samples == alone.samples);
@@ -271,6 +273,111 @@ TEST_CASE("rays cast by turns equal rays cast one at a time", "[raycast]") {
       CHECK(hits > 100);
       CHECK(hits < camera.width() * camera.height() - 100);
       CHECK(terminated > 10);
+    }
+  }
+}
+
+
+// tileSpan (tile_start.h) finds once per tile where its rays can first
+// and last meet a visible macrocell, and each ray walks only between:
+// no sample of any of the tile's rays before or after that span may lie
+// in a visible macrocell (each sample's macrocell as the walk finds it,
+// from its float position). A blob in one corner of a 96^3 grid and a
+// speck in the opposite one, so that the visible box is the whole grid
+// and the blob lies between empty space; views from outside (perspective
+// and orthographic), from inside the volume, and tiles that straddle the
+// silhouette. The marches must also cross at least half of the empty
+// space in front of and behind what most tiles meet, or they prove
+// nothing.
+TEST_CASE("a tile's rays walk only where one of them can meet a visible macrocell", "[raycast]") {
+  const GridGeometry grid = cubeGrid(96);
+  const Brick volume = makeVolume(grid, ScalarType::kUInt8, [](Vec3 p) {
+    const Vec3 blob = p - Vec3{70, 66, 72}, speck = p - Vec3{6.5, 8.5, 5.5};
+    if (std::max({std::abs(speck.x), std::abs(speck.y), std::abs(speck.z)}) < 0.6) return 250.0;
+    return 120.0 * std::exp(-dot(blob, blob) / (2 * 5.0 * 5.0));
+  });
+  const std::vector<Camera> views = {
+      makeCamera(Projection::kPerspective, {-120, -100, -80}, {70, 66, 72}, {0, 0, 1}, 12, 64, 64),
+      makeCamera(Projection::kOrthographic, {-60, 66, 72}, {70, 66, 72}, {0, 0, 1}, 40, 64, 64),
+      makeCamera(Projection::kOrthographic, {6, -80, 6}, {6, 8, 6}, {0, 0, 1}, 30, 64, 64),
+      makeCamera(Projection::kPerspective, {20, 15, 25}, {70, 66, 72}, {0, 0, 1}, 40, 64, 64),
+      makeCamera(Projection::kPerspective, {250, 66, 72}, {70, 66, 72}, {0, 0, 1}, 8, 64, 64),
+      makeCamera(Projection::kPerspective, {250, 150, 170}, {6, 8, 6}, {0, 0, 1}, 6, 64, 64)};
+  constexpr int kShift = MacrocellGrid::kShift;
+  constexpr std::int64_t kNone = std::numeric_limits<std::int64_t>::max();
+  // The speck alone: the visible box is one macrocell, where the rays
+  // start and end already; only the marches' soundness is tested.
+  for (const bool speckAlone : {false, true}) {
+    const TransferFunctionSpec tf = speckAlone ? speckOnly() : blobAndSpeck();
+    for (double step : {0.3, 1.0, 2.5}) {
+      MacrocellGrid macrocells(volume);
+      const TransferTable table(tf, step);
+      macrocells.classify(table, true);
+      KernelParams p;
+      setBrick(p, volume, macrocells);
+      setTables(p, table, nullptr, step);
+      auto visibleAt = [&](const RaySetup& r, std::int64_t k) {
+        int m[3];
+        for (int a = 0; a < 3; ++a) {
+          const float u = std::fma(float(k), float(r.step[a]), float(r.origin[a]));
+          m[a] = std::clamp(int(u) >> kShift, p.mcFirst[a], p.mcFirst[a] + p.mcCount[a] - 1);
+        }
+        return p.distance[kernel::macrocellIndex(p, m)] == 0;
+      };
+      int frontTiles = 0, frontCrossed = 0, backTiles = 0, backCrossed = 0;
+      for (std::size_t v = 0; v < views.size(); ++v) {
+        const Camera& camera = views[v];
+        for (int ty = 0; ty < camera.height(); ty += 16)
+          for (int tx = 0; tx < camera.width(); tx += 16) {
+            std::vector<RaySetup> rays;
+            for (int y = ty; y < ty + 16; ++y)
+              for (int x = tx; x < tx + 16; ++x)
+                rays.push_back(raySetup(camera.ray(x, y), volume.grid(), step, Vec3{0, 0, 1}));
+            const kernel::TileSpan span = kernel::tileSpan(p, rays.data(), int(rays.size()), kShift);
+            INFO("view " << v << " step " << step << " tile " << tx << ", " << ty << " span " << span.from << " "
+                         << span.to);
+            // The samples of all rays in the visible box, [earliest,
+            // latest]: where they would walk without the marches; and
+            // the first and last in a visible macrocell.
+            std::int64_t earliest = kNone, latest = -1, firstVisible = kNone, lastVisible = -1;
+            for (const RaySetup& r : rays) {
+              std::int64_t first, last;
+              if (!kernel::sampleRange(p, r, first, last)) continue;
+              std::int64_t k = first, end = last;
+              if (kernel::clipToVisible(p, r, k, end)) {
+                earliest = std::min(earliest, k);
+                latest = std::max(latest, end);
+              }
+              for (std::int64_t s = first; s <= last; ++s)
+                if (visibleAt(r, s)) {
+                  firstVisible = std::min(firstVisible, s);
+                  lastVisible = std::max(lastVisible, s);
+                }
+            }
+            REQUIRE(span.from <= firstVisible);
+            REQUIRE(span.to >= lastVisible);
+            if (firstVisible == kNone) continue;
+            // Where the rays cross empty space in the visible box before
+            // (after) they meet anything, the march should cross at least
+            // half of it.
+            if (double(firstVisible - earliest) * step > 4.0 * MacrocellGrid::kSize) {
+              ++frontTiles;
+              frontCrossed += 2 * (span.from - earliest) >= firstVisible - earliest;
+            }
+            if (double(latest - lastVisible) * step > 4.0 * MacrocellGrid::kSize) {
+              ++backTiles;
+              backCrossed += 2 * (latest - span.to) >= latest - lastVisible;
+            }
+          }
+      }
+      INFO("step " << step << ": " << frontCrossed << " of " << frontTiles << " tiles crossed the front, "
+                   << backCrossed << " of " << backTiles << " the back");
+      if (!speckAlone) {
+        CHECK(frontTiles >= 5);
+        CHECK(frontCrossed * 4 >= frontTiles * 3);
+        CHECK(backTiles >= 5);
+        CHECK(backCrossed * 4 >= backTiles * 3);
+      }
     }
   }
 }
