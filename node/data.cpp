@@ -368,7 +368,7 @@ void distributeData(NodeState& state) {
   else distributeStep(state, state.scene.volumes.front().source.timestep);
 }
 
-void showStep(NodeState& state, int step) {
+void showStep(NodeState& state, int step, StepFailure failures) {
   if (!state.renders() || !state.source) return;
   if (state.current && state.current->step == step) return;
   if (computationOf(state) && state.tree) {  // computed, not read: computation_data.h
@@ -392,11 +392,14 @@ void showStep(NodeState& state, int step) {
   }
   std::shared_ptr<ReadyBrick> ready;
   std::uint64_t misses = 0;
-  comm::runAgreed(cluster, [&] {
+  auto take = [&] {
     checkStep(state, step);
+    state.maybeFail("step");
     misses = state.cache.stats().misses;
     ready = state.cache.take(step);
-  });
+  };
+  if (failures == StepFailure::kOwn) take();
+  else comm::runAgreed(cluster, take);
   putOnScreen(state, std::move(ready), state.cache.stats().misses > misses);
 }
 

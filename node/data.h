@@ -45,12 +45,23 @@ void loadStep(NodeState& state);
 // render cluster's bricks; a no-op otherwise.
 void countHistogram(NodeState& state);
 
-// Collective over my render cluster (no-op elsewhere): makes `step` the
-// brick on screen, from the cache, read on demand, or by a distribution
-// when the format cannot read a box alone. Read and preprocessing time of a
-// step not read ahead go to pendingRead / pendingPreprocess. Every rank of
-// the cluster throws the first failure.
-void showStep(NodeState& state, int step);
+// Who learns of a failure to show a step that each rank reads alone (from
+// the cache or on demand; a distribution always agrees).
+enum class StepFailure {
+  kAgreed,  // every rank of the cluster throws the first failure
+  // Only the rank that failed throws: a wave carries the failure to the
+  // others with the sub-images it sends anyway (actions/wave.cpp), so a
+  // rank that has its step renders at once instead of waiting for the
+  // slowest read (8 ranks on 2 cores: the waiting ranks poll).
+  kOwn,
+};
+
+// Collective over my render cluster (no-op elsewhere) unless `failures`
+// is kOwn and the step is read per rank: makes `step` the brick on
+// screen, from the cache, read on demand, or by a distribution when the
+// format cannot read a box alone. Read and preprocessing time of a step
+// not read ahead go to pendingRead / pendingPreprocess.
+void showStep(NodeState& state, int step, StepFailure failures = StepFailure::kAgreed);
 
 // Collective: render clusters with a content-balanced decomposition
 // measure how even the new transfer function leaves their bricks and

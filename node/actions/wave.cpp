@@ -47,7 +47,7 @@ void renderMyFrame(NodeState& state, const Wave& args, std::optional<comm::Failu
     {
       // A step not held is read now: the longer stall limit applies.
       const comm::LivenessScope loading(state.liveness, comm::LivenessScope::Kind::kLoading);
-      showStep(state, w.timestep);
+      showStep(state, w.timestep, StepFailure::kOwn);  // a failure travels with the wave
     }
     state.cache.classifyAhead(aheadClassifier(state));
     state.cache.readAhead(myUpcoming(args.upcoming, me.group, state.layout.groups));

@@ -764,6 +764,22 @@ TEST_CASE_METHOD(Fixture, "a bad step is a clear error and the session serves on
   CHECK(job.close());
 }
 
+TEST_CASE_METHOD(Fixture, "a step that one rank fails to read fails its frame, and the next request shows every step", "[series]") {
+  // A wave's step is taken per rank without an agreement (showStep,
+  // StepFailure::kOwn): rank 0 shows step 1 while rank 1 failed to, the
+  // failure reaches the client with rank 1's sub-image, and rank 1 reads
+  // the step again when it is next shown.
+  Job job(2, {"--fail-once", "step@1"});
+  openSeries(job);
+  job.send(proto::RenderTimeSteps{1, 3, 1});
+  CHECK_THAT(job.expectError().text, Catch::Contains("rank 1 on " + thisHost() + ": injected failure in step"));
+  auto id = job.send(proto::RenderTimeSteps{1, 3, 1});
+  checkTimeSequence(job, id, {1, 2, 3});
+  id = job.send(proto::RenderTimeSteps{0, 1, 1});
+  checkTimeSequence(job, id, {0, 1});
+  CHECK(job.close());
+}
+
 TEST_CASE_METHOD(Fixture, "a failure on a rank that sends to a compositing cluster, or on a compositing rank, reaches the client") {
   Job job(4, {"--fail-once", "render@1", "--fail-once", "composite@2"});
   job.send(proto::SessionOpen{4, {{ClusterRole::kRender, 3, 0}, {ClusterRole::kComposite, 1, 0}}, ""});
