@@ -48,12 +48,16 @@ struct EarlyRead::State {
   bool handedOver = false;
 
   // The brick read early for `owned` and `stored` of `spec`, once; its
-  // load times count what it spent before this call as `early`.
+  // load times count what it spent before this call as `early`. The first
+  // call decides: a frame reads its brick once (distribute.h).
   std::optional<core::Brick> take(const core::VolumeSpec& of, const core::NodeBox& o, const core::NodeBox& s) {
     const std::lock_guard<std::mutex> lock(mutex);
     const auto asked = std::chrono::steady_clock::now();
     if (thread.joinable()) thread.join();
-    if (!brick || handedOver || !sameVolume(of, spec) || o != owned || s != stored) return std::nullopt;
+    if (!brick || handedOver || !sameVolume(of, spec) || o != owned || s != stored) {
+      brick.reset();  // the frame reads its own: not two bricks in memory
+      return std::nullopt;
+    }
     handedOver = true;
     std::optional<core::Brick> out = std::move(brick);
     brick.reset();
