@@ -1,4 +1,5 @@
-// A batch rank's brick, read while MPI starts (pvr-node --batch).
+// A batch rank's brick, read while MPI starts (pvr-node --batch), when
+// PVR_EARLY_READ=1 asks for it.
 //
 // MPI_Init takes 0.4-0.6 s on one host of 2 cores with 8 ranks, most of it
 // waiting on the launcher with the cores idle, and a first frame's rank
@@ -29,8 +30,9 @@ namespace pvr::node {
 
 class EarlyRead {
  public:
-  // Starts the thread when the launcher's environment names this rank and
-  // the world's size (OMPI_COMM_WORLD_RANK, OMPI_COMM_WORLD_SIZE); `scene`
+  // Starts the thread when PVR_EARLY_READ=1 and the launcher's environment
+  // names this rank and the world's size (OMPI_COMM_WORLD_RANK,
+  // OMPI_COMM_WORLD_SIZE); `scene`
   // loads the batch scene as the frame will (it runs on the thread, and
   // whatever it throws only stops the early read).
   EarlyRead(std::function<core::Scene()> scene, const FrameOptions& options);

@@ -1,6 +1,7 @@
-# pvr-node --batch reads each rank's brick while MPI starts (node/early_read.h)
-# when it reads its own box of a raw file (slabs and kd), and renders the
-# very frame it renders reading after MPI_Init (PVR_EARLY_READ=0) and what
+# pvr-node --batch with PVR_EARLY_READ=1 reads each rank's brick while MPI
+# starts (node/early_read.h) when it reads its own box of a raw file (slabs
+# and kd), and renders the very frame it renders reading after MPI_Init
+# (PVR_EARLY_READ=0, as unset) and what
 # pvr-render renders; a balanced decomposition (it reads twice) reads as
 # always. The --stats CSV's read_early column says which.
 cmake_minimum_required(VERSION 3.20)
@@ -56,7 +57,7 @@ foreach(decomposition slabs kd)
   batch(${decomposition}_early ${decomposition} 1)
   batch(${decomposition}_after ${decomposition} 0)
   if(NOT ${decomposition}_early_flags STREQUAL "111" OR NOT ${decomposition}_after_flags STREQUAL "000")
-    message(FATAL_ERROR "${decomposition}: every rank should read early (111) and none with PVR_EARLY_READ=0 (000); "
+    message(FATAL_ERROR "${decomposition}: every rank should read early (111) with PVR_EARLY_READ=1 and none with 0 (000); "
                         "got ${${decomposition}_early_flags} and ${${decomposition}_after_flags}")
   endif()
   same(${decomposition}_early ${decomposition}_after 0)
