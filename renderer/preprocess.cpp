@@ -91,6 +91,12 @@ void pickLattice(const T* __restrict wmin, const T* __restrict wmax, std::size_t
     omax[i] = wmax[std::size_t(kSize) * i];
   }
 }
+// Asks the cache for [p, p + n) ahead of its loads.
+inline void prefetchBytes(const void* p, std::size_t n) {
+  const char* c = static_cast<const char*>(p);
+  for (std::size_t i = 0; i < n; i += 64) __builtin_prefetch(c + i, 0, 3);
+}
+
 template <typename T>
 std::uint64_t countNonFinite(const T* __restrict r, std::size_t n) {
   std::uint64_t bad = 0;
@@ -224,6 +230,12 @@ class SlabAccumulator {
       const std::int64_t my = l_.first.y + j;
       const std::int64_t ya = std::max(st_.lo.y, my * kSize);
       const std::int64_t yb = std::min(st_.hi.y, my * kSize + kSize);
+      // The next macrocell row's new node rows, asked for now: each row is
+      // a short stream (2 KiB of a 2048-wide uint8 slab) that the hardware
+      // prefetcher has no time to learn, and waiting for their first loads
+      // was most of this pass (perf annotate). Rows are contiguous in a
+      // slab; a prefetch past the brick's mapping is harmless.
+      if (yb < st_.hi.y) prefetchBytes(row(yb + 1), std::size_t(std::min<std::int64_t>(kSize, st_.hi.y - yb)) * ex_ * sizeof(T));
       T* gmin = groupMin_.data();
       T* gmax = groupMax_.data();
       if (yb - ya == kSize) {

@@ -41,6 +41,33 @@ std::size_t FileStream::readSome(std::uint64_t offset, std::byte* dst, std::size
   return done;
 }
 
+namespace {
+
+// The page cache holds a large file in folios of up to 2 MiB (ext4, xfs);
+// a mapping whose address agrees with the file offset modulo 2 MiB lets
+// the kernel map each such folio with one page-table entry (a PMD) instead
+// of 512: the first touch takes one fault per 2 MiB instead of one per
+// 64 KiB (fault-around), the ray caster's and the bounds pass's TLB misses
+// drop, and the page tables neither cost memory nor take time to tear down.
+constexpr std::uint64_t kFolioAlign = std::uint64_t(2) << 20;
+
+// `total` bytes of anonymous zero pages, read-only, whose address is
+// congruent to `fileOffset` modulo kFolioAlign where the kernel allows it
+// (it trims a larger reservation); nullptr when it maps nothing.
+void* reserveAligned(std::size_t total, std::uint64_t fileOffset) {
+  const std::size_t slack = std::size_t(kFolioAlign);
+  void* wide = ::mmap(nullptr, total + slack, PROT_READ, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+  if (wide == MAP_FAILED) return nullptr;
+  const auto base = reinterpret_cast<std::uintptr_t>(wide);
+  const std::uintptr_t want = std::uintptr_t(fileOffset % kFolioAlign);
+  const std::uintptr_t at = base + ((want - base % kFolioAlign + kFolioAlign) % kFolioAlign);
+  if (at > base) ::munmap(wide, at - base);
+  if (base + total + slack > at + total) ::munmap(reinterpret_cast<void*>(at + total), base + total + slack - (at + total));
+  return reinterpret_cast<void*>(at);
+}
+
+}  // namespace
+
 std::shared_ptr<const std::byte> FileStream::lend(std::uint64_t offset, std::size_t n, std::size_t padding) {
   struct stat st {};
   if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode) || n == 0) return nullptr;
@@ -54,12 +81,14 @@ std::shared_ptr<const std::byte> FileStream::lend(std::uint64_t offset, std::siz
   // Address space for range and padding, anonymous zero pages; the file's
   // pages go over its start, so padding past the file's end reads zero
   // instead of faulting.
-  void* region = ::mmap(nullptr, total, PROT_READ, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-  if (region == MAP_FAILED) return nullptr;
+  void* region = reserveAligned(total, first);
+  if (!region) return nullptr;
   if (::mmap(region, fileBytes, PROT_READ, MAP_SHARED | MAP_FIXED, fd_, off_t(first)) == MAP_FAILED) {
     ::munmap(region, total);
     return nullptr;
   }
+  // A hint (THP "madvise" mode): map the cache's 2 MiB folios whole.
+  (void)::madvise(region, fileBytes, MADV_HUGEPAGE);
   std::shared_ptr<const std::byte> whole(static_cast<const std::byte*>(region),
                                          [total](const std::byte* p) { ::munmap(const_cast<std::byte*>(p), total); });
   return {whole, whole.get() + lead};

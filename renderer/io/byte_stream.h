@@ -52,8 +52,10 @@ class FileStream final : public ByteStream {
   void willNeed(std::uint64_t offset, std::size_t n) override;
   // Reads up to n bytes at offset; returns how many (fewer only at the end of the file).
   std::size_t readSome(std::uint64_t offset, std::byte* dst, std::size_t n);
-  // Maps the range read-only (MAP_SHARED: the page cache's own pages); the
-  // padding past it is the file's next bytes or zero pages. Checks the
+  // Maps the range read-only (MAP_SHARED: the page cache's own pages), at
+  // an address that agrees with the file offset modulo 2 MiB so the
+  // cache's large folios map whole (byte_stream.cpp); the padding past it
+  // is the file's next bytes or zero pages. Checks the
   // file still holds the range first: a file cut shorter while mapped
   // faults (SIGBUS) where read() would have reported it, so a volume file
   // must not be truncated while a session renders it.

@@ -36,6 +36,18 @@ if(TARGET pvr_comm_mpi AND TARGET pvr-node)
                          PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 60 PROCESSORS 2)
   endforeach()
 
+  # Ranks all on this host talk through the ob1 PML (shared memory), unless
+  # the user named a PML (mpi_communicator.cpp, preferSharedMemoryOnOneHost).
+  add_test(NAME "node mpi: ranks on one host use the ob1 PML"
+           COMMAND ${PVR_MPIRUN} -np 2 $<TARGET_FILE:pvr_node_mpi_driver> pml)
+  set_tests_properties("node mpi: ranks on one host use the ob1 PML" PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}"
+                       PASS_REGULAR_EXPRESSION "rank [01] pml ob1\n(.*\n)?rank [01] pml ob1\n" TIMEOUT 60 PROCESSORS 2)
+  add_test(NAME "node mpi: ranks on one host keep the PML the user named"
+           COMMAND ${PVR_MPIRUN} -np 2 $<TARGET_FILE:pvr_node_mpi_driver> pml)
+  set_tests_properties("node mpi: ranks on one host keep the PML the user named"
+                       PROPERTIES ENVIRONMENT "${PVR_MPI_ENV};OMPI_MCA_pml=^cm"
+                       PASS_REGULAR_EXPRESSION "rank [01] pml \\^cm\n(.*\n)?rank [01] pml \\^cm\n" TIMEOUT 60 PROCESSORS 2)
+
   # pvr-node --batch's report names every phase and each rank's peak RSS.
   add_test(NAME "node mpi: pvr-node --batch reports every phase and each rank's memory"
            COMMAND ${CMAKE_COMMAND}
@@ -56,6 +68,15 @@ if(TARGET pvr_comm_mpi AND TARGET pvr-node)
                      -P ${CMAKE_CURRENT_SOURCE_DIR}/pvr_node_test.cmake)
     set_tests_properties("node mpi: pvr-node --batch equals pvr-render"
                          PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 120 PROCESSORS 2)
+    # Each rank's brick read while MPI starts: the same frame as read after it.
+    add_test(NAME "node mpi: pvr-node --batch reads each brick while MPI starts and renders the same frame"
+             COMMAND ${CMAKE_COMMAND}
+                     -DMPIRUN=${MPIEXEC_EXECUTABLE} -DPVR_NODE=$<TARGET_FILE:pvr-node>
+                     -DPVR_RENDER=$<TARGET_FILE:pvr-render> -DDRIVER=$<TARGET_FILE:pvr_node_mpi_driver>
+                     -DDATA=${CMAKE_SOURCE_DIR}/../shared/data -DWORK=${PVR_MPI_SCRATCH}/early-read
+                     -P ${CMAKE_CURRENT_SOURCE_DIR}/early_read_test.cmake)
+    set_tests_properties("node mpi: pvr-node --batch reads each brick while MPI starts and renders the same frame"
+                         PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 180 PROCESSORS 2)
     add_test(NAME "node mpi: pvr-node --batch renders several volumes as pvr-render on 1 to 4 ranks"
              COMMAND ${CMAKE_COMMAND}
                      -DMPIRUN=${MPIEXEC_EXECUTABLE} -DPVR_NODE=$<TARGET_FILE:pvr-node>

@@ -18,6 +18,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -313,8 +314,15 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "compare: %s\n", e.what());
     return 1;
   }
+  if (mode == "pml" && argc == 2) {
+    // The PML a rank's MPI was told to use, as MpiEnvironment leaves it.
+    comm::MpiEnvironment mpi(&argc, &argv);
+    const char* pml = std::getenv("OMPI_MCA_pml");
+    std::printf("rank %d pml %s\n", mpi.world().rank(), pml ? pml : "(none)");
+    return 0;
+  }
   if ((mode != "matrix" && mode != "failure" && mode != "steering") || argc != 3) {
-    std::fprintf(stderr, "usage: %s matrix|failure|steering DIR | compare A.exr B.exr TOL\n", argv[0]);
+    std::fprintf(stderr, "usage: %s matrix|failure|steering DIR | pml | compare A.exr B.exr TOL\n", argv[0]);
     return 2;
   }
   comm::MpiEnvironment mpi(&argc, &argv);
