@@ -125,9 +125,7 @@ PreparedFrame prepareSeveral(const core::Scene& sceneIn, const FrameOptions& opt
   report.brickBytes = bricks->bytes();
   const core::LoadTimes loaded = bricks->loadTimes();
   report.read = loaded.read;
-  report.dist = std::max(0.0, secondsSince(distStart) - (loaded.read + loaded.preprocess - loaded.early));
-  report.early = loaded.early;
-  report.readEarly = loaded.readEarly;
+  report.dist = std::max(0.0, secondsSince(distStart) - loaded.read - loaded.preprocess);
 
   // A transfer function left to the data takes its own volume's range.
   const auto summaries = summarizeVolumes(comm, bricks.get(), result.scene.volumes.size(), false);
@@ -152,19 +150,6 @@ PreparedFrame prepareSeveral(const core::Scene& sceneIn, const FrameOptions& opt
 
 }  // namespace
 
-FrameVolume openFrameVolume(const core::Scene& sceneIn, const FrameOptions& options) {
-  FrameVolume out;
-  const core::VolumeSpec& spec = sceneIn.volumes.front().source;
-  out.source = options.openVolume ? options.openVolume(spec) : core::openSceneVolume(spec);
-  out.source->setFineCounts(false);  // a frame reports no histogram: the reader counts nothing
-  out.scene = sceneIn;
-  core::resolveDefaults(out.scene, out.source->grid());
-  overrideEarlyTermination(out.scene, options);
-  out.renderOptions = core::renderOptionsFor(out.scene);
-  out.ghostLayers = core::ghostLayers(out.source->grid(), out.renderOptions);
-  return out;
-}
-
 PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& options,
                            comm::Communicator& comm) {
   if (needsSceneBricks(sceneIn)) return prepareSeveral(sceneIn, options, comm);
@@ -180,11 +165,13 @@ PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& optio
   core::RenderOptions renderOptions;
   runAgreed(comm, [&] {
     composite::makeStrategy(options.strategy, options.strategyParams);
-    FrameVolume opened = openFrameVolume(sceneIn, options);
-    source = std::move(opened.source);
-    result.scene = std::move(opened.scene);
-    renderOptions = opened.renderOptions;
-    result.ghostLayers = opened.ghostLayers;
+    source = options.openVolume ? options.openVolume(sceneIn.volumes.front().source) : core::openSceneVolume(sceneIn.volumes.front().source);
+    source->setFineCounts(false);  // a frame reports no histogram: the reader counts nothing
+    result.scene = sceneIn;
+    core::resolveDefaults(result.scene, source->grid());
+    overrideEarlyTermination(result.scene, options);
+    renderOptions = core::renderOptionsFor(result.scene);
+    result.ghostLayers = core::ghostLayers(source->grid(), renderOptions);
     result.volume = source->describe();
     result.volumeBytes = std::uint64_t(source->grid().allNodes().nodeCount()) * core::scalarSize(source->type());
   });
@@ -197,9 +184,7 @@ PreparedFrame prepareFrame(const core::Scene& sceneIn, const FrameOptions& optio
   // The reader's seconds are inside the distribution's; dist keeps the rest.
   const core::LoadTimes& loaded = prepared.bricks.brick.loadTimes();
   report.read = loaded.read;
-  report.dist = std::max(0.0, secondsSince(distStart) - (loaded.read + loaded.preprocess - loaded.early));
-  report.early = loaded.early;
-  report.readEarly = loaded.readEarly;
+  report.dist = std::max(0.0, secondsSince(distStart) - loaded.read - loaded.preprocess);
 
   // A transfer function left to the data takes the whole volume's range.
   const std::optional<DataSummary> summary = summarizeData(comm, &prepared.bricks.brick, false);

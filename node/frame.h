@@ -16,7 +16,6 @@
 #include "image.h"
 #include "image_codec.h"
 #include "io/volume_io.h"
-#include "raycast/raycaster.h"
 #include "scene.h"
 #include "strategy.h"
 
@@ -45,8 +44,6 @@ struct RankReport {
   double prep = 0;   // preprocessing: the reader's (value range, macrocell bounds while reading)
                      // plus building the renderer's macrocell grid and classifying
   double dist = 0;   // the rest of distribution: open, decompose, scatter
-  double early = 0;  // of read + prep, the seconds before the frame began (read while MPI started, early_read.h)
-  std::uint32_t readEarly = 0;  // 1: the brick was read while MPI started
   double rend = 0;   // ray casting the brick
   double comp = 0;   // compositing computation
   double comm = 0;   // compositing communication
@@ -71,19 +68,6 @@ struct FrameResult {
 // (message "rank R: ..." of the lowest failing rank).
 FrameResult renderFrame(const core::Scene& scene, const FrameOptions& options,
                         comm::Communicator& comm);
-
-// The scene's one volume opened as a frame opens it: the source (reading
-// no histogram counts: a frame reports none), the scene resolved for its
-// grid, the render options and the ghost layers a brick needs. Throws
-// pvr::Error as opening and resolving do. prepareFrame's first step, and
-// what an early read (early_read.h) places its brick by.
-struct FrameVolume {
-  std::unique_ptr<core::VolumeSource> source;
-  core::Scene scene;
-  core::RenderOptions renderOptions;
-  int ghostLayers = 0;
-};
-FrameVolume openFrameVolume(const core::Scene& scene, const FrameOptions& options);
 
 // Seconds since this process started (0 where /proc cannot tell), and its
 // peak resident memory so far (getrusage): the report's start and RSS.

@@ -25,12 +25,10 @@
 // once, by rank 0, naming the rank and its host.
 #include <chrono>
 #include <cstdio>
-#include <memory>
 #include <string>
 #include <vector>
 
 #include "catalog_listing.h"
-#include "early_read.h"
 #include "frame.h"
 #include "hosts.h"
 #include "image_output.h"
@@ -164,28 +162,12 @@ Args parseArgs(int argc, char** argv) {
   return a;
 }
 
-core::Scene batchScene(const Args& args) {
-  core::Scene scene = core::loadSceneFile(args.scene);
-  if (args.width > 0) scene.image.width = args.width, scene.image.height = args.height;
-  return scene;
-}
-
-// The brick read while MPI starts (node/early_read.h), from the command
-// line as parsed before MPI_Init; none for a command line that does not
-// parse (the agreed parse after MPI_Init reports it).
-std::unique_ptr<node::EarlyRead> startEarlyRead(int argc, char** argv) {
-  try {
-    const Args args = parseArgs(argc, argv);
-    return std::make_unique<node::EarlyRead>([args] { return batchScene(args); }, args.frame);
-  } catch (const Error&) {
-    return nullptr;
-  }
-}
-
-int run(Args args, const std::vector<std::string>& hosts, const node::EarlyRead* early, comm::Communicator& comm) {
+int run(const Args& args, const std::vector<std::string>& hosts, comm::Communicator& comm) {
   core::Scene scene;
-  comm::runAgreed(comm, [&] { scene = batchScene(args); });
-  if (early) args.frame.openVolume = early->opener();
+  comm::runAgreed(comm, [&] {
+    scene = core::loadSceneFile(args.scene);
+    if (args.width > 0) scene.image.width = args.width, scene.image.height = args.height;
+  });
   const node::FrameResult result = node::renderFrame(scene, args.frame, comm);
   comm::runAgreed(comm, [&] {
     if (comm.rank() != 0) return;
@@ -220,12 +202,11 @@ int main(int argc, char** argv) {
     }
     return node::runServer(options);
   }
-  const std::unique_ptr<node::EarlyRead> early = startEarlyRead(argc, argv);
   comm::MpiEnvironment mpi(&argc, &argv);
   comm::Communicator& comm = mpi.world();
   const std::vector<std::string> hosts = node::gatherHostNames(comm);
   try {
-    return run(parseArgs(argc, argv), hosts, early.get(), comm);
+    return run(parseArgs(argc, argv), hosts, comm);
   } catch (const Error& e) {
     if (comm.rank() == 0) {
       // A rank's failure names its host: "rank 2 on h1: ...".

@@ -77,11 +77,6 @@ std::string formatReport(const FrameResult& result, const FrameOptions& options,
               "own seconds and overlap only where it preprocesses on other threads while reading)\n",
               "sum", sumOfMax);
   out += line("%-8s %9.4f   (rank 0, from its process start to the written image)\n", "wall", output.wall);
-  double early = 0;
-  for (const RankReport& r : ranks) early = std::max(early, r.early);
-  if (early > 0)
-    out += line("%-8s %9.4f   (most of a rank's read and prep done while MPI started, inside start: "
-                "the brick read early, node/early_read.h)\n", "early", early);
   const TrafficTotals traffic = sumTraffic(ranks);
   const std::uint64_t messages = traffic.messages, maxMessages = traffic.maxMessagesPerRank,
                       raw = traffic.rawBytes, encoded = traffic.encodedBytes, pixels = traffic.pixels,
@@ -115,7 +110,7 @@ void writeStatsCsv(const std::string& path, const FrameResult& result, const Fra
   if (!out) throw Error(ErrorCode::kIo, path + ": cannot open for writing");
   out << "rank,ranks,strategy,decomposition,width,height,dist,rend,comp,comm,send,messages,"
          "raw_bytes,encoded_bytes,pixels_sent,gather_messages,gather_bytes,brick_bytes,volume_bytes,"
-         "start,read,prep,write,wall,peak_rss_bytes,early,read_early\n";
+         "start,read,prep,write,wall,peak_rss_bytes\n";
   for (std::size_t i = 0; i < result.ranks.size(); ++i) {
     const RankReport& r = result.ranks[i];
     out << i << ',' << result.ranks.size() << ',' << options.strategy << ','
@@ -125,8 +120,7 @@ void writeStatsCsv(const std::string& path, const FrameResult& result, const Fra
         << r.composite.encodedBytesSent << ',' << r.composite.pixelsSent << ','
         << r.composite.gatherMessagesSent << ',' << r.composite.gatherBytesSent << ',' << r.brickBytes
         << ',' << result.volumeBytes << ',' << r.start << ',' << r.read << ',' << r.prep << ','
-        << (i == 0 ? output.write : 0.0) << ',' << (i == 0 ? output.wall : 0.0) << ',' << r.peakRssBytes << ','
-        << r.early << ',' << r.readEarly << '\n';
+        << (i == 0 ? output.write : 0.0) << ',' << (i == 0 ? output.wall : 0.0) << ',' << r.peakRssBytes << '\n';
   }
   if (!out) throw Error(ErrorCode::kIo, path + ": write failed");
 }

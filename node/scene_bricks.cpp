@@ -25,8 +25,6 @@ core::LoadTimes SceneBricks::loadTimes() const {
     if (b) {
       sum.read += b->loadTimes().read;
       sum.preprocess += b->loadTimes().preprocess;
-    sum.early += b->loadTimes().early;
-    sum.readEarly = sum.readEarly || b->loadTimes().readEarly;
     }
   return sum;
 }

@@ -25,15 +25,10 @@ class ThreadPool;
 // `preprocess` computing its value range and macrocell bounds (the fused
 // pass of a reader, or updateValueRange()). A brick that carries no bounds
 // gets them from the MacrocellGrid its BrickRenderer builds; that time is
-// BrickRenderer::preprocessSeconds(), not part of these. A brick read
-// before anyone asked for it (a batch rank reads it while MPI starts,
-// node/early_read.h) is `readEarly`, and `early` of read + preprocess
-// seconds ran before it was asked for.
+// BrickRenderer::preprocessSeconds(), not part of these.
 struct LoadTimes {
   double read = 0;
   double preprocess = 0;
-  double early = 0;
-  bool readEarly = false;
 };
 
 // The finite values of a brick. Non-finite voxels (NaN, Inf) are counted, not

@@ -68,15 +68,6 @@ if(TARGET pvr_comm_mpi AND TARGET pvr-node)
                      -P ${CMAKE_CURRENT_SOURCE_DIR}/pvr_node_test.cmake)
     set_tests_properties("node mpi: pvr-node --batch equals pvr-render"
                          PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 120 PROCESSORS 2)
-    # Each rank's brick read while MPI starts: the same frame as read after it.
-    add_test(NAME "node mpi: pvr-node --batch reads each brick while MPI starts and renders the same frame"
-             COMMAND ${CMAKE_COMMAND}
-                     -DMPIRUN=${MPIEXEC_EXECUTABLE} -DPVR_NODE=$<TARGET_FILE:pvr-node>
-                     -DPVR_RENDER=$<TARGET_FILE:pvr-render> -DDRIVER=$<TARGET_FILE:pvr_node_mpi_driver>
-                     -DDATA=${CMAKE_SOURCE_DIR}/../shared/data -DWORK=${PVR_MPI_SCRATCH}/early-read
-                     -P ${CMAKE_CURRENT_SOURCE_DIR}/early_read_test.cmake)
-    set_tests_properties("node mpi: pvr-node --batch reads each brick while MPI starts and renders the same frame"
-                         PROPERTIES ENVIRONMENT "${PVR_MPI_ENV}" TIMEOUT 180 PROCESSORS 2)
     add_test(NAME "node mpi: pvr-node --batch renders several volumes as pvr-render on 1 to 4 ranks"
              COMMAND ${CMAKE_COMMAND}
                      -DMPIRUN=${MPIEXEC_EXECUTABLE} -DPVR_NODE=$<TARGET_FILE:pvr-node>
