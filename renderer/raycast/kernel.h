@@ -332,22 +332,32 @@ inline bool inside(const KernelParams& p, const RaySetup& r, double k) {
   return true;
 }
 
-// The samples [first, last] of this ray inside the owned box; false if none.
-inline bool sampleRange(const KernelParams& p, const RaySetup& r, std::int64_t& first,
-                        std::int64_t& last) {
-  double kmin = 0, kmax = 1e18;
+// Narrows [kmin, kmax], in steps along ray r, to where the ray lies in the
+// box [lo, hi], slab by slab; false when it misses the box along an axis it
+// does not move on. The one ray-box intersection of the owned box, the
+// visible box and the domain (callers round and test exactly after it).
+template <typename Bound>
+inline bool clipToBox(const RaySetup& r, const Bound* lo, const Bound* hi, double& kmin, double& kmax) {
   for (int a = 0; a < 3; ++a) {
+    const double l = double(lo[a]), h = double(hi[a]);
     if (r.step[a] == 0) {
-      if (r.origin[a] < p.ownLo[a] || r.origin[a] > p.ownHi[a]) return false;
+      if (!(r.origin[a] >= l && r.origin[a] <= h)) return false;
       continue;
     }
-    double k0 = (p.ownLo[a] - r.origin[a]) * r.invStep[a];
-    double k1 = (p.ownHi[a] - r.origin[a]) * r.invStep[a];
+    double k0 = (l - r.origin[a]) * r.invStep[a];
+    double k1 = (h - r.origin[a]) * r.invStep[a];
     if (k0 > k1) std::swap(k0, k1);
     kmin = std::max(kmin, k0);
     kmax = std::min(kmax, k1);
   }
-  if (kmin > kmax + 2) return false;
+  return true;
+}
+
+// The samples [first, last] of this ray inside the owned box; false if none.
+inline bool sampleRange(const KernelParams& p, const RaySetup& r, std::int64_t& first,
+                        std::int64_t& last) {
+  double kmin = 0, kmax = 1e18;
+  if (!clipToBox(r, p.ownLo, p.ownHi, kmin, kmax) || kmin > kmax + 2) return false;
   // The estimate is within a sample (rounding); the exact test decides.
   first = std::max<std::int64_t>(0, std::int64_t(std::ceil(kmin)) - 1);
   last = std::int64_t(std::floor(kmax)) + 1;
@@ -363,20 +373,10 @@ inline bool sampleRange(const KernelParams& p, const RaySetup& r, std::int64_t& 
 // (KernelParams::visibleLo): the others lie in invisible macrocells, which
 // the ray would only walk past. False if none is left.
 inline bool clipToVisible(const KernelParams& p, const RaySetup& r, std::int64_t& first, std::int64_t& last) {
+  for (int a = 0; a < 3; ++a)
+    if (!(p.visibleLo[a] <= p.visibleHi[a])) return false;  // nothing visible
   double kmin = double(first), kmax = double(last);
-  for (int a = 0; a < 3; ++a) {
-    if (!(p.visibleLo[a] <= p.visibleHi[a])) return false;
-    if (r.step[a] == 0) {
-      if (r.origin[a] < p.visibleLo[a] || r.origin[a] > p.visibleHi[a]) return false;
-      continue;
-    }
-    double k0 = (p.visibleLo[a] - r.origin[a]) * r.invStep[a];
-    double k1 = (p.visibleHi[a] - r.origin[a]) * r.invStep[a];
-    if (k0 > k1) std::swap(k0, k1);
-    kmin = std::max(kmin, k0);
-    kmax = std::min(kmax, k1);
-  }
-  if (!(kmin <= kmax)) return false;
+  if (!clipToBox(r, p.visibleLo, p.visibleHi, kmin, kmax) || !(kmin <= kmax)) return false;
   first = std::max(first, std::int64_t(std::floor(kmin)));
   last = std::min(last, std::int64_t(std::ceil(kmax)));
   return first <= last;
@@ -407,20 +407,10 @@ inline bool inDomain(const KernelParams& p, const RaySetup& r, std::int64_t k) {
 // The ray's chord through the domain in steps, [kIn, kOut] with kIn >= 0
 // (samples start at t = 0); false if it misses.
 inline bool domainChord(const KernelParams& p, const RaySetup& r, double& kIn, double& kOut) {
+  static constexpr float kOrigin[3] = {0, 0, 0};
   kIn = 0;
   kOut = 1e18;
-  for (int a = 0; a < 3; ++a) {
-    if (r.step[a] == 0) {
-      if (!(r.origin[a] >= 0.0 && r.origin[a] <= double(p.domainMax[a]))) return false;
-      continue;
-    }
-    double k0 = -r.origin[a] * r.invStep[a];
-    double k1 = (double(p.domainMax[a]) - r.origin[a]) * r.invStep[a];
-    if (k0 > k1) std::swap(k0, k1);
-    kIn = std::max(kIn, k0);
-    kOut = std::min(kOut, k1);
-  }
-  return kIn <= kOut;
+  return clipToBox(r, kOrigin, p.domainMax, kIn, kOut) && kIn <= kOut;
 }
 
 // The chord ends of a ray whose samples [first, last] lie in this brick
