@@ -74,12 +74,22 @@ inline constexpr std::int64_t kBlocksPerChunk = 4;
 
 }  // namespace kernel
 
+// One ray; its samples outside `span` lie in invisible macrocells
+// (tileSpan(), tile_start.h; by default nothing is known).
 template <typename T, bool kShaded>
-RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShift) {
+RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShift,
+                          const kernel::TileSpan& span = {}) {
   std::int64_t first, last;
   if (!kernel::sampleRange(p, ray, first, last)) return castRay<T, kShaded, false>(p, ray, mcShift);
   RayResult out;
   out.hit = true;
+  // The march starts and ends where castRay's walk does (the visible box,
+  // the tile's span): the samples outside are in invisible macrocells,
+  // transparent at every level as the empty space skipped below is.
+  std::int64_t k = first, end = last;
+  if (!kernel::clipToVisible(p, ray, k, end)) return out;
+  k = std::max(k, span.from);
+  end = std::min(end, span.to);
   const kernel::ChordEnds ends = kernel::chordEnds(p, ray, first, last);
   // A coarse chunk has no chord end in it (blockLevel).
   const kernel::ChordEnds noEnds{-1, std::numeric_limits<std::int64_t>::max(), 0, 0};
@@ -90,8 +100,7 @@ RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShif
   const float d[3] = {float(ray.step[0]), float(ray.step[1]), float(ray.step[2])};
   const kernel::CubeExit cube(ray, mcShift);
   kernel::Accumulator acc;
-  std::int64_t k = first;  // the next fine sample not yet covered or skipped
-  while (k <= last) {
+  while (k <= end) {  // k: the next fine sample not yet covered or skipped
     // Empty space is skipped as castRay skips it: a coarse sample in
     // skipped space is transparent too.
     if (const std::int64_t next = kernel::pastEmpty(p, cube, o, d, k, mcShift); next != k) {
@@ -101,7 +110,7 @@ RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShif
     const std::int64_t block = k >> kLevelBlockShift, blockEnd = (block + 1) << kLevelBlockShift;
     const int level = kernel::blockLevel(p, ray, ends, block);
     if (level == 0) {
-      std::int64_t exit = std::min(last + 1, k + kernel::kVisibleChunk);
+      std::int64_t exit = std::min(end + 1, k + kernel::kVisibleChunk);
       if (exit > blockEnd && kernel::blockLevel(p, ray, ends, block + 1) != 0) exit = blockEnd;
       if (kernel::runSpan<T, kShaded, false>(p, ray, ends, k, exit, acc, out.samples)) break;
       k = exit;
@@ -112,16 +121,16 @@ RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShif
       coarseSet[level] = true;
     }
     // The block's coarse samples from k on that this brick owns (theirs
-    // are fine samples in [k, last]), with those of the next blocks of the
+    // are fine samples in [k, end]), with those of the next blocks of the
     // same level, a chunk at a time.
     const std::int64_t start = kernel::coarseFrom(k, level);
     std::int64_t runEnd = blockEnd;
-    while (runEnd <= last && runEnd - blockEnd < (kernel::kBlocksPerChunk - 1) * kLevelBlock &&
+    while (runEnd <= end && runEnd - blockEnd < (kernel::kBlocksPerChunk - 1) * kLevelBlock &&
            (runEnd >> level) - start < kernel::kVisibleChunk &&
            kernel::blockLevel(p, ray, ends, runEnd >> kLevelBlockShift) == level)
       runEnd += kLevelBlock;
     const std::int64_t exit =
-        std::min({kernel::coarseFrom(last + 1, level), runEnd >> level, start + kernel::kVisibleChunk});
+        std::min({kernel::coarseFrom(end + 1, level), runEnd >> level, start + kernel::kVisibleChunk});
     if (start < exit &&
         kernel::runSpan<T, kShaded, false>(p.atLevel[level], coarse[level], noEnds, start, exit, acc, out.samples))
       break;

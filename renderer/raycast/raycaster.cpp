@@ -28,12 +28,11 @@ RayFunction pickKernel(bool shaded, bool preintegrated) {
   return preintegrated ? &castRays<T, false, true> : &castRays<T, false, false>;
 }
 
-// A kernel of one ray at a time as a RayFunction (that walks each ray
-// whole: the span only saves look-ups).
-template <RayResult (*kCast)(const KernelParams&, const RaySetup&, int)>
-void oneByOne(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan&,
+// A kernel of one ray at a time as a RayFunction.
+template <RayResult (*kCast)(const KernelParams&, const RaySetup&, int, const kernel::TileSpan&)>
+void oneByOne(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan& span,
               RayResult* out) {
-  for (int i = 0; i < n; ++i) out[i] = kCast(p, rays[i], mcShift);
+  for (int i = 0; i < n; ++i) out[i] = kCast(p, rays[i], mcShift, span);
 }
 
 RayFunction pickKernel(ScalarType type, bool shaded, bool preintegrated) {

@@ -14,10 +14,12 @@
 #include <vector>
 
 #include "raycast/cast_ray.h"
+#include "raycast/cast_ray_levels.h"
 #include "raycast/kernel.h"
 #include "raycast/kernel_setup.h"
 #include "raycast/macrocells.h"
 #include "raycast/raycaster.h"
+#include "raycast/step_levels.h"
 #include "raycast/tile_start.h"
 #include "reference.h"
 #include "transfer.h"
@@ -101,6 +103,24 @@ std::pair<IVec3, IVec3> visibleBoxOf(const Brick& volume, const TransferTable& t
         }
       }
   return {lo, hi};
+}
+
+// A blob in one corner of a 96^3 grid and a speck in the opposite one:
+// the visible box is the whole grid and the blob lies between empty space.
+Brick blobAndSpeckVolume() {
+  return makeVolume(cubeGrid(96), ScalarType::kUInt8, [](Vec3 p) {
+    const Vec3 blob = p - Vec3{70, 66, 72}, speck = p - Vec3{6.5, 8.5, 5.5};
+    if (std::max({std::abs(speck.x), std::abs(speck.y), std::abs(speck.z)}) < 0.6) return 250.0;
+    return 120.0 * std::exp(-dot(blob, blob) / (2 * 5.0 * 5.0));
+  });
+}
+
+// The rays of the 16x16 tile at (tx, ty), sample k at k * step.
+std::vector<RaySetup> tileRays(const Camera& camera, int tx, int ty, const GridGeometry& grid, double step) {
+  std::vector<RaySetup> rays;
+  for (int y = ty; y < ty + 16; ++y)
+    for (int x = tx; x < tx + 16; ++x) rays.push_back(raySetup(camera.ray(x, y), grid, step, Vec3{0, 0, 1}));
+  return rays;
 }
 
 }  // namespace
@@ -290,12 +310,7 @@ TEST_CASE("rays cast by turns equal rays cast one at a time", "[raycast]") {
 // space in front of and behind what most tiles meet, or they prove
 // nothing.
 TEST_CASE("a tile's rays walk only where one of them can meet a visible macrocell", "[raycast]") {
-  const GridGeometry grid = cubeGrid(96);
-  const Brick volume = makeVolume(grid, ScalarType::kUInt8, [](Vec3 p) {
-    const Vec3 blob = p - Vec3{70, 66, 72}, speck = p - Vec3{6.5, 8.5, 5.5};
-    if (std::max({std::abs(speck.x), std::abs(speck.y), std::abs(speck.z)}) < 0.6) return 250.0;
-    return 120.0 * std::exp(-dot(blob, blob) / (2 * 5.0 * 5.0));
-  });
+  const Brick volume = blobAndSpeckVolume();
   const std::vector<Camera> views = {
       makeCamera(Projection::kPerspective, {-120, -100, -80}, {70, 66, 72}, {0, 0, 1}, 12, 64, 64),
       makeCamera(Projection::kOrthographic, {-60, 66, 72}, {70, 66, 72}, {0, 0, 1}, 40, 64, 64),
@@ -329,10 +344,7 @@ TEST_CASE("a tile's rays walk only where one of them can meet a visible macrocel
         const Camera& camera = views[v];
         for (int ty = 0; ty < camera.height(); ty += 16)
           for (int tx = 0; tx < camera.width(); tx += 16) {
-            std::vector<RaySetup> rays;
-            for (int y = ty; y < ty + 16; ++y)
-              for (int x = tx; x < tx + 16; ++x)
-                rays.push_back(raySetup(camera.ray(x, y), volume.grid(), step, Vec3{0, 0, 1}));
+            const std::vector<RaySetup> rays = tileRays(camera, tx, ty, volume.grid(), step);
             const kernel::TileSpan span = kernel::tileSpan(p, rays.data(), int(rays.size()), kShift);
             INFO("view " << v << " step " << step << " tile " << tx << ", " << ty << " span " << span.from << " "
                          << span.to);
@@ -379,6 +391,67 @@ TEST_CASE("a tile's rays walk only where one of them can meet a visible macrocel
         CHECK(backCrossed * 4 >= backTiles * 3);
       }
     }
+  }
+}
+
+// Quality chosen by error (castRayByLevels) walks only the tile's span as
+// castRay does: the same colours as without the span to the last bit; and
+// a span cut short ends the rays there (the span is used, not just
+// computed).
+// The blob between empty space, seen so that the rays cross empty space
+// before and behind it; shaded and not, at a target that mixes levels.
+TEST_CASE("the step chosen per region walks only the tile's span and draws the same rays", "[raycast][levels]") {
+  const Brick volume = blobAndSpeckVolume();
+  const std::vector<Camera> views = {
+      makeCamera(Projection::kPerspective, {-120, -100, -80}, {70, 66, 72}, {0, 0, 1}, 12, 48, 48),
+      makeCamera(Projection::kOrthographic, {-60, 66, 72}, {70, 66, 72}, {0, 0, 1}, 40, 48, 48)};
+  constexpr int kShift = MacrocellGrid::kShift;
+  const TransferFunctionSpec tf = blobAndSpeck();
+  const double sceneStep = 1.0, fine = fineStep(sceneStep);
+  StepLevels levels(volume, sceneStep);
+  levels.choose(tf, 40.0, 0.0);
+  std::vector<TransferTable> tables;
+  for (int l = 0; l < kStepLevels; ++l) tables.emplace_back(tf, fine * double(1 << l));
+  MacrocellGrid macrocells(volume);
+  macrocells.classify(tables.front(), true);
+  KernelParams p;
+  setBrick(p, volume, macrocells);
+  setTables(p, tables.front(), nullptr, fine);
+  std::vector<KernelParams> atLevel;
+  setLevels(p, levels, tables, fine, atLevel);
+  for (const bool shaded : {false, true}) {
+    RenderOptions o = makeOptions(sceneStep, false, shaded);
+    const std::vector<float> specular = specularTable(o.shading.shininess);
+    setOptions(p, o, specular.data());
+    for (KernelParams& q : atLevel) setOptions(q, o, specular.data());
+    auto cast = shaded ? &castRayByLevels<std::uint8_t, true> : &castRayByLevels<std::uint8_t, false>;
+    std::uint64_t samplesWithSpan = 0, samplesCut = 0;
+    int hits = 0;
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      const Camera& camera = views[v];
+      for (int ty = 0; ty < camera.height(); ty += 16)
+        for (int tx = 0; tx < camera.width(); tx += 16) {
+          const std::vector<RaySetup> rays = tileRays(camera, tx, ty, volume.grid(), fine);
+          const kernel::TileSpan span = kernel::tileSpan(p, rays.data(), int(rays.size()), kShift);
+          for (std::size_t i = 0; i < rays.size(); ++i) {
+            const RayResult with = cast(p, rays[i], kShift, span), without = cast(p, rays[i], kShift, {});
+            const RayResult cut = cast(p, rays[i], kShift, {span.from, span.from + (span.to - span.from) / 4});
+            INFO("shaded " << shaded << " view " << v << " tile " << tx << ", " << ty << " ray " << i);
+            CHECK(with.colour.r == without.colour.r);
+            CHECK(with.colour.g == without.colour.g);
+            CHECK(with.colour.b == without.colour.b);
+            CHECK(with.colour.a == without.colour.a);
+            CHECK(cut.samples <= with.samples);
+            samplesWithSpan += with.samples;
+            samplesCut += cut.samples;
+            hits += without.colour.a > 0.01f;
+          }
+        }
+    }
+    INFO("shaded " << shaded << ": " << samplesWithSpan << " samples with the span, " << samplesCut
+                   << " with a quarter of it, " << hits << " rays see something");
+    CHECK(hits > 50);
+    CHECK(2 * samplesCut < samplesWithSpan);
   }
 }
 
