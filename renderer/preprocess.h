@@ -12,7 +12,8 @@
 // happens, so a reader can hand each slab over right after it lands and
 // the data is touched once (raw_reader.cpp). Float data skips NaN and Inf
 // in both range and bounds, and counts them. The same pass counts the
-// histogram's fine keys of the voxels a brick owns (value_histogram.h):
+// histogram's fine keys of the voxels a brick owns (value_histogram.h,
+// fine_counts.h):
 // one table increment per owned voxel, one per 64 bytes of one value,
 // nothing per ghost.
 #pragma once
