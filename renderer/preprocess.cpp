@@ -402,4 +402,38 @@ Preprocessed preprocessVoxels(ScalarType type, const NodeBox& owned, const NodeB
   return out;
 }
 
+std::shared_ptr<FineHistogram> countFineKeys(ScalarType type, const NodeBox& stored, const std::byte* voxels,
+                                             const NodeBox& counted, ThreadPool* pool) {
+  auto out = emptyHistogram(type, &counted, stored);
+  if (counted.empty()) return out;
+  dispatchScalar(type, [&](auto tag) {
+    using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+    const T* v = reinterpret_cast<const T*>(voxels);
+    const std::size_t ex = std::size_t(stored.extent(0)), slabNodes = ex * std::size_t(stored.extent(1));
+    auto countSlabs = [&](FineCounter<T>& counter, std::int64_t z0, std::int64_t z1) {
+      for (std::int64_t z = z0; z < z1; ++z)
+        for (std::int64_t y = counted.lo.y; y <= counted.hi.y; ++y)
+          counter.countRow(v + std::size_t(z - stored.lo.z) * slabNodes + std::size_t(y - stored.lo.y) * ex +
+                               std::size_t(counted.lo.x - stored.lo.x),
+                           std::size_t(counted.extent(0)));
+    };
+    // Chunks of slabs, a few per thread so uneven chunks balance, into one
+    // counter per thread: a 16-bit counter is 512 KiB to clear and add up.
+    const std::int64_t slabs = counted.extent(2);
+    const std::int64_t chunks = pool ? std::min<std::int64_t>(slabs, 4 * pool->size()) : 1;
+    std::vector<std::optional<FineCounter<T>>> counters(std::size_t(pool ? pool->size() : 1));
+    auto runChunk = [&](std::size_t c, int worker) {
+      auto& counter = counters[std::size_t(worker)];
+      if (!counter) counter.emplace();
+      countSlabs(*counter, counted.lo.z + slabs * std::int64_t(c) / chunks,
+                 counted.lo.z + slabs * (std::int64_t(c) + 1) / chunks);
+    };
+    if (chunks > 1) pool->parallelFor(std::size_t(chunks), runChunk);
+    else runChunk(0, 0);
+    for (const auto& counter : counters)
+      if (counter) counter->addTo(out->counts);
+  });
+  return out;
+}
+
 }  // namespace pvr::core

@@ -69,4 +69,11 @@ Preprocessed preprocessVoxels(ScalarType type, const NodeBox& owned, const NodeB
                               const std::byte* voxels, ThreadPool* pool = nullptr,
                               const NodeBox* counted = nullptr);
 
+// Only the fine histogram of the `counted` box (inside `stored`), for a
+// brick that has its range and bounds: the same counts as preprocessVoxels,
+// without its min/max work (a quarter of that pass for 8- and 16-bit data).
+// Over the pool's threads when one is given (chunks of slabs).
+std::shared_ptr<FineHistogram> countFineKeys(ScalarType type, const NodeBox& stored, const std::byte* voxels,
+                                             const NodeBox& counted, ThreadPool* pool = nullptr);
+
 }  // namespace pvr::core

@@ -172,11 +172,13 @@ std::vector<Row> measure(Brick& b, const std::string& name, const std::vector<in
     Row r{name, old.type, "new", threads, voxels};
     // Bounds as a load runs them (the raw reader without fine counts: the
     // server counts the histogram later, when a Status asks; runtime.md),
-    // and the fine counts as the extra time of the pass that counts them too.
+    // and that count (Brick::countFineHistogram).
     Preprocessed boundsOnly;
     r.bounds = seconds([&] { boundsOnly = preprocessVoxels(b.type(), b.owned(), b.stored(), cb.bytes(), p); }, 3);
-    const double withCounts = seconds([&] { b.updateValueRange(p); }, 3);
-    r.histogram = std::max(0.0, withCounts - r.bounds);
+    const NodeBox counted = countedBox(b.owned(), b.grid());
+    std::shared_ptr<FineHistogram> counts;
+    r.histogram = seconds([&] { counts = countFineKeys(b.type(), b.stored(), cb.bytes(), counted, p); }, 3);
+    b.updateValueRange(p);  // the brick's bounds and counts in one pass, for the checks below
     MacrocellGrid grid(cb);
     r.classify = seconds([&] { grid.classify(table, true, p); }, 3);
     ContentGrid content;
@@ -189,7 +191,8 @@ std::vector<Row> measure(Brick& b, const std::string& name, const std::vector<in
                std::equal(om.distance.begin(), om.distance.end(), grid.distance(),
                           [](std::uint8_t exact, std::uint8_t leap) { return leapDistanceFits(leap, exact); });
     const MacrocellBounds& nb = grid.bounds();
-    r.agrees = r.agrees && cb.fineHistogram() && cb.fineHistogram()->counts == expectedCounts;
+    r.agrees = r.agrees && counts->counts == expectedCounts && cb.fineHistogram() &&
+               cb.fineHistogram()->counts == expectedCounts;
     for (std::size_t i = 0; i < om.min.size() && r.agrees; ++i) {
       r.agrees = boundsOnly.bounds->minAt(i) == nb.minAt(i) && boundsOnly.bounds->maxAt(i) == nb.maxAt(i);
       if (!r.agrees) break;
@@ -260,13 +263,14 @@ int main(int argc, char** argv) {
 
   // Step: the table, the CSV and the text file.
   text << "bounds = value range + macrocell min/max, as a load runs them; hist = the fine histogram's\n"
-          "counts (one table increment per voxel), the extra time of the pass that also counts them\n"
-          "(updateValueRange; a server counts them when a Status first asks, not for a frame);\n"
+          "counts alone (one table increment per voxel; a server counts them when a Status first asks,\n"
+          "not for a frame: countFineKeys);\n"
           "classify = visibility + distance field;\n"
           "content = content counts in 8^3 blocks; total = bounds + classify + content;\n"
           "Mvox/s/core = voxels / total / threads; +hist = voxels / (total + hist) / threads;\n"
           "best of 3 runs for new, 1 for old (single-threaded: it has no threads); agrees = new\n"
-          "range, bounds and counts equal old's, the fine histogram a count of every voxel, and the distances are its exact ones as the leap\n"
+          "range, bounds and counts equal old's, the fine histogram (alone and from the pass with the bounds)\n"
+          "a count of every voxel, and the distances are its exact ones as the leap\n"
           "distance promises (exact below 16 macrocells, a close lower bound beyond; leap_distance.h).\n"
           "stream = memory speed: the min and max of the brick's bytes read as uint16, one streaming pass\n"
           "on one thread (its time in the bounds column; best of 3).\n";

@@ -1,8 +1,9 @@
-// Fine counts (fine_counts.h): whatever path a block of a row takes (one
+// Fine counts (fine_counts.h, preprocess.h): whatever path a block of a row takes (one
 // addition for a flat block, one table for a block without neighbouring
 // repeats, two or four tables in turn, the row's tail) and however often
 // the 32-bit tables go to the 64-bit totals, the counts equal a count of
-// every voxel.
+// every voxel; and counting them alone (countFineKeys) gives the counts of
+// the pass that also computes the bounds.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -12,7 +13,10 @@
 #include <type_traits>
 #include <vector>
 
+#include "brick.h"
 #include "fine_counts.h"
+#include "preprocess.h"
+#include "thread_pool.h"
 
 namespace pvr::core {
 namespace {
@@ -90,6 +94,52 @@ TEST_CASE("a 16-bit key counted 2^32 + 2 times keeps every count past the 32-bit
   counter.addTo(counts);
   CHECK(counts[40000] == (std::uint64_t(1) << 32) + 2);
   CHECK(counts[7] == 1);
+}
+
+TEST_CASE("counting the fine keys alone equals a count of every voxel, single-threaded and on a pool", "[preprocess]") {
+  // Odd grid, owned boxes at a corner, off the macrocell lattice and at the
+  // far end, ghost layers or none; int16 over its whole range (negative
+  // values too), float with NaN.
+  GridGeometry grid;
+  grid.dims = {67, 13, 11};
+  grid.spacing = {1, 1, 1};
+  const NodeBox owned[] = {grid.allNodes(), {{0, 0, 0}, {33, 6, 5}}, {{5, 3, 2}, {50, 11, 9}}, {{34, 6, 5}, {66, 12, 10}}};
+  ThreadPool pool(2);
+  std::uint32_t seed = 3;
+  for (ScalarType type : {ScalarType::kUInt8, ScalarType::kUInt16, ScalarType::kInt16, ScalarType::kFloat32})
+    for (const NodeBox& own : owned)
+      for (int ghost : {0, 2}) {
+        CAPTURE(scalarName(type), toString(own), ghost);
+        Brick b(grid, type, own, own.grown(ghost).intersect(grid.allNodes()));
+        const NodeBox counted = countedBox(own, grid);
+        std::vector<std::uint64_t> expected(fineKeyCount(type), 0);
+        std::mt19937 rng(seed++);
+        dispatchScalar(type, [&](auto tag) {
+          using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+          T* v = b.as<T>();
+          const std::size_t n = std::size_t(b.stored().nodeCount());
+          for (std::size_t i = 0; i < n; ++i) {
+            if constexpr (std::is_floating_point_v<T>)
+              v[i] = i % 17 == 0 ? std::numeric_limits<T>::quiet_NaN() : T(std::uniform_real_distribution<float>(-5, 5)(rng));
+            else  // runs of one value now and then, so flat blocks and repeats occur
+              v[i] = i % 97 < 40 ? T(-7) : T(std::uniform_int_distribution<long>(long(std::numeric_limits<T>::lowest()),
+                                                                                 long(std::numeric_limits<T>::max()))(rng));
+          }
+          for (std::int64_t z = counted.lo.z; z <= counted.hi.z; ++z)
+            for (std::int64_t y = counted.lo.y; y <= counted.hi.y; ++y)
+              for (std::int64_t x = counted.lo.x; x <= counted.hi.x; ++x) {
+                const T value = v[b.linearIndex({x, y, z})];
+                if (std::isfinite(double(value))) ++expected[fineKey(value)];
+              }
+        });
+        const std::byte* voxels = std::as_const(b).bytes();
+        CHECK(countFineKeys(type, b.stored(), voxels, counted)->counts == expected);
+        CHECK(countFineKeys(type, b.stored(), voxels, counted, &pool)->counts == expected);
+        // The brick's own count, after a reader that counted nothing.
+        b.countFineHistogram(&pool);
+        REQUIRE(b.fineHistogram());
+        CHECK(b.fineHistogram()->counts == expected);
+      }
 }
 
 }  // namespace pvr::core
