@@ -130,7 +130,7 @@ void Brick::updateValueRange(ThreadPool* pool) {
 void Brick::countFineHistogram(ThreadPool* pool) {
   if (histogram_) return;
   const NodeBox counted = countedBox(owned_, grid_);
-  histogram_ = preprocessVoxels(type_, owned_, stored_, std::as_const(*this).bytes(), pool, &counted).histogram;
+  histogram_ = countFineKeys(type_, stored_, std::as_const(*this).bytes(), counted, pool);
 }
 
 void Brick::setPreprocessed(const ValueRange& range, std::shared_ptr<const MacrocellBounds> bounds,

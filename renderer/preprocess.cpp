@@ -1,15 +1,13 @@
 #include "preprocess.h"
 
 #include <algorithm>
-#if defined(__AVX512BW__)
-#include <immintrin.h>
-#endif
-#include <cstring>
-#include <type_traits>
 #include <mutex>
+#include <optional>
+#include <type_traits>
 #include <vector>
 
 #include "error.h"
+#include "fine_counts.h"
 #include "thread_pool.h"
 
 namespace pvr::core {
@@ -104,78 +102,6 @@ std::uint64_t countNonFinite(const T* __restrict r, std::size_t n) {
   return bad;
 }
 
-// Whether the 64 bytes at `p` hold one integer value only: one compare
-// with AVX-512, else an OR of differences, which compilers vectorise
-// (a compare per element ORed as bool they do not: perf had that at one
-// instruction chain per voxel).
-template <typename T>
-inline bool blockIsFlat(const T* p) {
-  static_assert(std::is_integral_v<T>);
-#if defined(__AVX512BW__)
-  const __m512i v = _mm512_loadu_si512(p);
-  if constexpr (sizeof(T) == 1) return _mm512_cmpneq_epi8_mask(v, _mm512_set1_epi8(char(p[0]))) == 0;
-  else return _mm512_cmpneq_epi16_mask(v, _mm512_set1_epi16(short(p[0]))) == 0;
-#else
-  using U = std::make_unsigned_t<T>;
-  U differ = 0;
-  for (std::size_t k = 1; k < 64 / sizeof(T); ++k) differ |= U(U(p[k]) ^ U(p[0]));
-  return differ == 0;
-#endif
-}
-
-// Fine-count tables a row is counted into, taken in turn so that
-// consecutive values do not wait on each other's increment (neighbours
-// often share a value): four for 8-bit data (8 KB in all; eight measured
-// no faster), two for the others (65536 keys each).
-template <typename T> constexpr std::size_t kCountTables = sizeof(T) == 1 ? 4 : 2;
-template <typename T> constexpr std::size_t kTableKeys = std::size_t(1) << (sizeof(T) == 1 ? 8 : 16);  // fineKeyCount
-
-// Adds the fine keys of a row's finite values to the tables `t`
-// (kCountTables<T> of kTableKeys<T> each, one after the other). An integer
-// row counts a block of kRunBlock equal values (air, flat regions: much of
-// a scan) with one addition, where one increment after another of the
-// same key would each wait for the last; 8-bit data takes a changing
-// block's values eight at a time from one load.
-template <typename T>
-void countRow(const T* __restrict r, std::size_t n, std::uint64_t* __restrict t) {
-  constexpr std::size_t K = kTableKeys<T>;
-  std::uint64_t* __restrict a = t;
-  std::uint64_t* __restrict b = t + K;
-  std::size_t i = 0;
-  if constexpr (!std::is_floating_point_v<T>) {
-    constexpr std::size_t kRunBlock = 64 / sizeof(T);
-    for (; i + kRunBlock <= n; i += kRunBlock) {
-      const T first = r[i];
-      if (blockIsFlat(r + i)) {
-        a[fineKey(first)] += kRunBlock;
-        continue;
-      }
-      if constexpr (sizeof(T) == 1) {
-        for (std::size_t k = 0; k < kRunBlock; k += 8) {
-          std::uint64_t w;
-          std::memcpy(&w, r + i + k, 8);  // little or big endian: each byte is counted once either way
-          for (std::size_t byte = 0; byte < 8; ++byte) ++t[byte % kCountTables<T> * K + ((w >> (8 * byte)) & 255)];
-        }
-      } else {
-        for (std::size_t k = 0; k < kRunBlock; k += 2) {
-          ++a[fineKey(r[i + k])];
-          ++b[fineKey(r[i + k + 1])];
-        }
-      }
-    }
-  }
-  for (; i + 1 < n; i += 2) {
-    if constexpr (std::is_floating_point_v<T>) {
-      if ((r[i] - r[i]) == T(0)) ++a[fineKey(r[i])];
-      if ((r[i + 1] - r[i + 1]) == T(0)) ++b[fineKey(r[i + 1])];
-    } else {
-      ++a[fineKey(r[i])];
-      ++b[fineKey(r[i + 1])];
-    }
-  }
-  if (i < n && (r[i] - r[i]) == T(0)) ++a[fineKey(r[i])];
-}
-
 // Folds slabs into the macrocell layers [layerLo, layerHi) (relative to
 // layout.first.z) of `bounds`, and the slabs it is told to count into a
 // value range of its own.
@@ -188,7 +114,7 @@ class SlabAccumulator {
         ex_(std::size_t(stored.extent(0))) {
     if (counted && !counted->empty()) {
       counted_ = *counted;
-      counts_.assign(kCountTables<T> * kTableKeys<T>, 0);
+      counts_.emplace();
     }
     groupMin_.resize(ex_);
     groupMax_.resize(ex_);
@@ -296,9 +222,9 @@ class SlabAccumulator {
     }
 
     // Step: count the owned voxels' keys, each slab once (countRange).
-    if (countRange && !counts_.empty() && z >= counted_.lo.z && z <= counted_.hi.z)
+    if (countRange && counts_ && z >= counted_.lo.z && z <= counted_.hi.z)
       for (std::int64_t y = counted_.lo.y; y <= counted_.hi.y; ++y)
-        countRow(row(y) + std::size_t(counted_.lo.x - st_.lo.x), std::size_t(counted_.extent(0)), counts_.data());
+        counts_->countRow(row(y) + std::size_t(counted_.lo.x - st_.lo.x), std::size_t(counted_.extent(0)));
 
     // Step: widen the layers.
     if (into0) foldLayer(m0);
@@ -317,7 +243,7 @@ class SlabAccumulator {
 
   // Adds the counted keys to `out` (sized fineKeyCount); nothing without a counted box.
   void addCounts(std::vector<std::uint64_t>& out) const {
-    for (std::size_t k = 0; k < counts_.size(); ++k) out[k % kTableKeys<T>] += counts_[k];
+    if (counts_) counts_->addTo(out);
   }
 
  private:
@@ -341,8 +267,8 @@ class SlabAccumulator {
   T rangeLo_ = emptyMin<T>(), rangeHi_ = emptyMax<T>();  // ... and its nodes outside every macrocell
   std::vector<T> slabMin_, slabMax_;    // this slab's 2-D macrocell bounds
   std::uint64_t nonFinite_ = 0;
-  NodeBox counted_;                     // histogram box, when counts_ is sized
-  std::vector<std::uint64_t> counts_;   // fine key counts, kCountTables<T> tables (countRow)
+  NodeBox counted_;                     // histogram box, when counts_ is there
+  std::optional<FineCounter<T>> counts_;  // its fine key counts
 };
 
 ValueRange mergeRanges(const ValueRange& a, const ValueRange& b) {
@@ -473,6 +399,40 @@ Preprocessed preprocessVoxels(ScalarType type, const NodeBox& owned, const NodeB
   ValueRange range = ranges[0];
   for (std::size_t c = 1; c < ranges.size(); ++c) range = mergeRanges(range, ranges[c]);
   out.range = finalRange(range);
+  return out;
+}
+
+std::shared_ptr<FineHistogram> countFineKeys(ScalarType type, const NodeBox& stored, const std::byte* voxels,
+                                             const NodeBox& counted, ThreadPool* pool) {
+  auto out = emptyHistogram(type, &counted, stored);
+  if (counted.empty()) return out;
+  dispatchScalar(type, [&](auto tag) {
+    using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
+    const T* v = reinterpret_cast<const T*>(voxels);
+    const std::size_t ex = std::size_t(stored.extent(0)), slabNodes = ex * std::size_t(stored.extent(1));
+    auto countSlabs = [&](FineCounter<T>& counter, std::int64_t z0, std::int64_t z1) {
+      for (std::int64_t z = z0; z < z1; ++z)
+        for (std::int64_t y = counted.lo.y; y <= counted.hi.y; ++y)
+          counter.countRow(v + std::size_t(z - stored.lo.z) * slabNodes + std::size_t(y - stored.lo.y) * ex +
+                               std::size_t(counted.lo.x - stored.lo.x),
+                           std::size_t(counted.extent(0)));
+    };
+    // Chunks of slabs, a few per thread so uneven chunks balance, into one
+    // counter per thread: a 16-bit counter is 512 KiB to clear and add up.
+    const std::int64_t slabs = counted.extent(2);
+    const std::int64_t chunks = pool ? std::min<std::int64_t>(slabs, 4 * pool->size()) : 1;
+    std::vector<std::optional<FineCounter<T>>> counters(std::size_t(pool ? pool->size() : 1));
+    auto runChunk = [&](std::size_t c, int worker) {
+      auto& counter = counters[std::size_t(worker)];
+      if (!counter) counter.emplace();
+      countSlabs(*counter, counted.lo.z + slabs * std::int64_t(c) / chunks,
+                 counted.lo.z + slabs * (std::int64_t(c) + 1) / chunks);
+    };
+    if (chunks > 1) pool->parallelFor(std::size_t(chunks), runChunk);
+    else runChunk(0, 0);
+    for (const auto& counter : counters)
+      if (counter) counter->addTo(out->counts);
+  });
   return out;
 }
 

@@ -12,7 +12,8 @@
 // happens, so a reader can hand each slab over right after it lands and
 // the data is touched once (raw_reader.cpp). Float data skips NaN and Inf
 // in both range and bounds, and counts them. The same pass counts the
-// histogram's fine keys of the voxels a brick owns (value_histogram.h):
+// histogram's fine keys of the voxels a brick owns (value_histogram.h,
+// fine_counts.h):
 // one table increment per owned voxel, one per 64 bytes of one value,
 // nothing per ghost.
 #pragma once
@@ -67,5 +68,12 @@ class SlabPreprocessor {
 Preprocessed preprocessVoxels(ScalarType type, const NodeBox& owned, const NodeBox& stored,
                               const std::byte* voxels, ThreadPool* pool = nullptr,
                               const NodeBox* counted = nullptr);
+
+// Only the fine histogram of the `counted` box (inside `stored`), for a
+// brick that has its range and bounds: the same counts as preprocessVoxels,
+// without its min/max work (a quarter of that pass for 8- and 16-bit data).
+// Over the pool's threads when one is given (chunks of slabs).
+std::shared_ptr<FineHistogram> countFineKeys(ScalarType type, const NodeBox& stored, const std::byte* voxels,
+                                             const NodeBox& counted, ThreadPool* pool = nullptr);
 
 }  // namespace pvr::core
