@@ -76,6 +76,7 @@ std::shared_ptr<ReadyBrick> BrickCache::take(int step) {
     if (!reader_) throw pvr::Error(pvr::ErrorCode::kInternal, "brick cache: step " + std::to_string(step) + " has no reader");
   }
   // A miss: read on this thread (the background one may be reading another step).
+  announce(step);
   std::shared_ptr<ReadyBrick> ready = makeReady(reader_(step), step);
   std::lock_guard lock(mutex_);
   stepBytes_ = ready->bytes();
@@ -134,6 +135,7 @@ void BrickCache::readAheadLoop() {
     const auto start = std::chrono::steady_clock::now();
     std::shared_ptr<ReadyBrick> ready;
     try {
+      announce(step);
       ready = makeReady(reader_(step), step);
       if (classifier.classify) {
         classifier.classify(*ready->renderer);
@@ -152,6 +154,14 @@ void BrickCache::readAheadLoop() {
   queued_.clear();  // what is left is read on demand
   active_ = false;
   done_.notify_all();
+}
+
+void BrickCache::announce(int step) const {
+  try {
+    if (prefetch_) prefetch_(step);
+  } catch (...) {
+    // A hint: the read reports what is wrong with the step.
+  }
 }
 
 void BrickCache::stopReadAhead() {
