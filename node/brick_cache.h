@@ -72,6 +72,9 @@ struct CacheStats {
   std::uint64_t bytesHeld = 0;  // brick bytes of the steps held
   std::uint64_t stepsHeld = 0;
   double readAheadSeconds = 0;  // background reading and preprocessing
+  // The background thread's CPU for them (its own clock): what reading
+  // ahead takes from the render threads where the cores are all busy.
+  double readAheadCpuSeconds = 0;
 };
 
 class BrickCache {

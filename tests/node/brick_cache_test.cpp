@@ -134,6 +134,9 @@ TEST_CASE("read-ahead makes the upcoming steps hits, and never evicts a step on 
   CHECK(cache.stats().hits == 2);
   CHECK(cache.stats().misses == 1);
   CHECK(cache.stats().readAheadSeconds > 0);
+  // The background thread's CPU for those reads: some, within their wall time.
+  CHECK(cache.stats().readAheadCpuSeconds > 0);
+  CHECK(cache.stats().readAheadCpuSeconds <= cache.stats().readAheadSeconds + 1e-3);
   // Step 3 did not fit: read now, evicting 1 (used before 2), not 0.
   cache.take(3);
   CHECK(cache.stats().misses == 2);
