@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 
 #include "error.h"
 
@@ -14,6 +15,13 @@ namespace {
 
 double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// CPU seconds the calling thread has used.
+double threadCpuSeconds() {
+  timespec t{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
 }
 
 bool contains(const std::vector<int>& steps, int step) {
@@ -76,6 +84,7 @@ std::shared_ptr<ReadyBrick> BrickCache::take(int step) {
     if (!reader_) throw pvr::Error(pvr::ErrorCode::kInternal, "brick cache: step " + std::to_string(step) + " has no reader");
   }
   // A miss: read on this thread (the background one may be reading another step).
+  announce(step);
   std::shared_ptr<ReadyBrick> ready = makeReady(reader_(step), step);
   std::lock_guard lock(mutex_);
   stepBytes_ = ready->bytes();
@@ -132,8 +141,10 @@ void BrickCache::readAheadLoop() {
     const AheadClassifier classifier = classifier_;
     lock.unlock();
     const auto start = std::chrono::steady_clock::now();
+    const double cpuStart = threadCpuSeconds();
     std::shared_ptr<ReadyBrick> ready;
     try {
+      announce(step);
       ready = makeReady(reader_(step), step);
       if (classifier.classify) {
         classifier.classify(*ready->renderer);
@@ -142,8 +153,10 @@ void BrickCache::readAheadLoop() {
     } catch (...) {
       // The step's failure is reported when it is needed and read on demand.
     }
+    const double seconds = secondsSince(start), cpuSeconds = threadCpuSeconds() - cpuStart;
     lock.lock();
-    stats_.readAheadSeconds += secondsSince(start);
+    stats_.readAheadSeconds += seconds;
+    stats_.readAheadCpuSeconds += cpuSeconds;
     if (ready && makeRoom(ready->bytes(), {}, false)) holdLocked(ready);
     reading_ = -1;
     done_.notify_all();
@@ -152,6 +165,14 @@ void BrickCache::readAheadLoop() {
   queued_.clear();  // what is left is read on demand
   active_ = false;
   done_.notify_all();
+}
+
+void BrickCache::announce(int step) const {
+  try {
+    if (prefetch_) prefetch_(step);
+  } catch (...) {
+    // A hint: the read reports what is wrong with the step.
+  }
 }
 
 void BrickCache::stopReadAhead() {

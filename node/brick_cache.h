@@ -72,6 +72,9 @@ struct CacheStats {
   std::uint64_t bytesHeld = 0;  // brick bytes of the steps held
   std::uint64_t stepsHeld = 0;
   double readAheadSeconds = 0;  // background reading and preprocessing
+  // The background thread's CPU for them (its own clock): what reading
+  // ahead takes from the render threads where the cores are all busy.
+  double readAheadCpuSeconds = 0;
 };
 
 class BrickCache {
@@ -89,9 +92,10 @@ class BrickCache {
   ~BrickCache() { clear(); }
 
   // Drops every step (a new volume, tree or ghost layers) and reads with
-  // `reader` from now on; a null reader allows no reading ahead. A budget
-  // that holds no step reads nothing ahead, but `prefetch` announces the
-  // next step, so its read when it is shown finds the file's pages in
+  // `reader` from now on; a null reader allows no reading ahead. Every
+  // step the cache reads, `prefetch` announces first (announce, below). A
+  // budget that holds no step reads nothing ahead, but `prefetch` announces
+  // the next step, so its read when it is shown finds the file's pages in
   // memory (fetched while the frame before rendered).
   void reset(Reader reader, Prefetcher prefetch = nullptr);
   // Drops every step and the reader.
@@ -117,6 +121,16 @@ class BrickCache {
   CacheStats stats() const;
 
  private:
+  // Announces `step` to the storage (prefetch_) just before the cache
+  // reads it, on either thread, so a lent brick (raw_reader.cpp) maps pages
+  // the announcement put in the page cache. Unannounced, its pages come in
+  // by faults, which fill the cache with large folios: on this project's VM
+  // the first touch of a cold 2 MiB slab read that way cost 5-8 ms of CPU
+  // (no fault counted: the time is the hypervisor's, likely backing memory
+  // it had taken back), announced 0.2 ms plus 0.3-0.4 ms of the calls. The
+  // read-ahead thread spent 6 ms a step of a 256^3 series on 8 ranks
+  // before, 1.2 ms after (bench/results/scale/series_cache5.md).
+  void announce(int step) const;
   void stopReadAhead();  // waits for the background thread
   void readAheadLoop();  // the background thread: reads queued_ in order
   // Under mutex_: makes room for `bytes`, evicting steps not in `keep`

@@ -38,10 +38,12 @@ void prepareCacheRank(NodeState& state) {
     for (int i = mine; i < n; i += m) {
       NodeState::ServedRank& s = state.served[{c, i}];
       s.cache = std::make_unique<BrickCache>();
-      s.cache->reset([source = state.source.get(), owned = tree.ownedBox(i),
-                      stored = core::storedBox(tree, i, state.ghost)](int step) {
-        return source->step(step).readBox(owned, stored);
-      });
+      const core::NodeBox stored = core::storedBox(tree, i, state.ghost);
+      s.cache->reset(
+          [source = state.source.get(), owned = tree.ownedBox(i), stored](int step) {
+            return source->step(step).readBox(owned, stored);
+          },
+          [source = state.source.get(), stored](int step) { source->step(step).prefetchBox(stored); });
       s.shown = state.scene.volumes.front().source.timestep;
       keys.push_back({c, i});
     }

@@ -125,6 +125,16 @@ set later [lmap p $phases {
 puts "$opt(-kind) mean per frame after the first: [join $later " "]"
 if {$opt(-series) && ![catch {:s performance cache} cache]} {
     puts "$opt(-kind) cache after `render time`: $cache"
+    # What reading ahead cost per frame, summed over the ranks: the part of
+    # cpu_s_frame the background threads took (read_ahead_cpu_s).
+    set aheadCpu 0.0
+    set aheadWall 0.0
+    foreach r [dict get $cache ranks] {
+        if {[dict exists $r read_ahead_cpu_s]} { set aheadCpu [expr {$aheadCpu + [dict get $r read_ahead_cpu_s]}] }
+        set aheadWall [expr {$aheadWall + [dict get $r read_ahead_s]}]
+    }
+    puts [format "%s read-ahead per frame over the ranks: %.4f CPU s, %.4f s wall" \
+              $opt(-kind) [expr {$aheadCpu / $frames}] [expr {$aheadWall / $frames}]]
 }
 set peaks [pvrNodePeaks $pids]
 :s close

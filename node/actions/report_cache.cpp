@@ -1,6 +1,6 @@
 // report_cache: each render and cache rank's brick caches (brick_cache.h,
 // cache_cluster.h) for "performance cache": hits, misses, bytes and steps
-// held, read-ahead seconds, by world rank, and the budget. The master keeps the answer in
+// held, read-ahead seconds (wall and CPU), by world rank, and the budget. The master keeps the answer in
 // state.reply; docs/protocol.md lists the keys.
 #include "table.h"
 
@@ -11,7 +11,7 @@ void ReportCache::run(NodeState& state, const ReportCache& args) {
   constexpr std::size_t kCounters = 4;
   const std::size_t ranks = std::size_t(state.world.size()), me = std::size_t(state.world.rank());
   std::vector<std::uint64_t> counts(ranks * kCounters, 0);
-  std::vector<double> seconds(ranks, 0);
+  std::vector<double> seconds(ranks * 2, 0);  // read-ahead wall and CPU seconds
   // A render rank's own cache; a cache rank's caches of the ranks it serves.
   std::vector<const BrickCache*> caches;
   if (state.renders()) caches.push_back(&state.cache);
@@ -20,7 +20,8 @@ void ReportCache::run(NodeState& state, const ReportCache& args) {
     const CacheStats s = cache->stats();
     const std::uint64_t row[kCounters] = {s.hits, s.misses, s.bytesHeld, s.stepsHeld};
     for (std::size_t k = 0; k < kCounters; ++k) counts[me * kCounters + k] += row[k];
-    seconds[me] += s.readAheadSeconds;
+    seconds[me * 2] += s.readAheadSeconds;
+    seconds[me * 2 + 1] += s.readAheadCpuSeconds;
   }
   state.world.allReduceSum(counts);
   state.world.allReduceMax(seconds);
@@ -34,7 +35,8 @@ void ReportCache::run(NodeState& state, const ReportCache& args) {
       const std::size_t i = std::size_t(r);
       perRank.push_back({{"rank", r}, {"cluster", c}, {"role", roleName(plan.role)}, {"hits", counts[i * kCounters]},
                          {"misses", counts[i * kCounters + 1]}, {"bytes", counts[i * kCounters + 2]},
-                         {"steps", counts[i * kCounters + 3]}, {"read_ahead_s", seconds[i]}});
+                         {"steps", counts[i * kCounters + 3]}, {"read_ahead_s", seconds[i * 2]},
+                         {"read_ahead_cpu_s", seconds[i * 2 + 1]}});
     }
   }
   state.reply = {{"ranks", perRank}, {"budget_bytes", cacheBudgetBytes(state.settings)}};

@@ -613,6 +613,9 @@ std::pair<std::uint64_t, std::uint64_t> cacheCounts(Job& job) {
     misses += r["misses"].get<std::uint64_t>();
     CHECK(r["bytes"].get<std::uint64_t>() <= reply["budget_bytes"].get<std::uint64_t>());
     CHECK(r["read_ahead_s"].get<double>() >= 0);
+    // One thread's CPU over the reads it timed: within their wall time.
+    CHECK(r["read_ahead_cpu_s"].get<double>() >= 0);
+    CHECK(r["read_ahead_cpu_s"].get<double>() <= r["read_ahead_s"].get<double>() + 1e-3);
   }
   return {hits, misses};
 }
