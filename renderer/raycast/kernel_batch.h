@@ -3,8 +3,10 @@
 // The scalar loop spends most of its ~100 instructions a sample on
 // position, cell, fraction, index and interpolation arithmetic that does
 // not depend on the other samples; here eight samples share each of those
-// instructions. Voxels are fetched with scalar loads (this machine's
-// hardware gathers cost ~19 cycles each, slower than loads). Plain
+// instructions. Float voxels are fetched with scalar loads (hardware
+// gathers were measured at ~19 cycles each, slower than loads); integer
+// voxels with one 32-bit gather per corner pair, which beat eight loads
+// and inserts on the peer scene (batch_loads.h). Plain
 // classification and compositing take the eight samples together as well
 // (kernel_batch_over.h), and so do the pre-integrated batch's eight
 // segments, lit (shade_lanes.h) eight at a time, unless one is opaque: then

@@ -40,12 +40,19 @@ struct Quads {
 // two entries are 32 contiguous bytes, one load per lane), interpolated
 // with the lanes' weights: the same lerp as classify1D.
 [[gnu::always_inline]] inline Quads classifyQuads(const Rgba* table, __m256i entry, __m256 weight) {
+  // The entries' byte offsets, read back as scalars: extracting the eight
+  // lanes from a register took the shuffle port, which the batch is short
+  // of, where loads are not (the empty asm keeps GCC from turning the reads
+  // back into extractions).
   alignas(32) std::int32_t e[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(e), entry);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(e), _mm256_slli_epi32(entry, 4));
+  asm("" : "+m"(e));
+  static_assert(sizeof(Rgba) == 16, "an entry is four floats");
+  const char* bytes = reinterpret_cast<const char*>(table);
   Quads out;
   for (int j = 0; j < 4; ++j) {
-    const __m256 low = _mm256_loadu_ps(&table[e[j]].r);       // entries of sample j
-    const __m256 high = _mm256_loadu_ps(&table[e[j + 4]].r);  // entries of sample j + 4
+    const __m256 low = _mm256_loadu_ps(reinterpret_cast<const float*>(bytes + e[j]));       // entries of sample j
+    const __m256 high = _mm256_loadu_ps(reinterpret_cast<const float*>(bytes + e[j + 4]));  // entries of sample j + 4
     const __m256 front = _mm256_permute2f128_ps(low, high, 0x20);  // entry e of both
     const __m256 back = _mm256_permute2f128_ps(low, high, 0x31);   // entry e + 1 of both
     const __m256 w = _mm256_permutevar8x32_ps(weight, _mm256_setr_epi32(j, j, j, j, j + 4, j + 4, j + 4, j + 4));
