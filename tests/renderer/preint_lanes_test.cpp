@@ -4,9 +4,7 @@
 // opacity 1, empty cells, non-finite voxels and runs shorter than a batch.
 #include <catch2/catch.hpp>
 
-#include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <random>
 #include <vector>
 
@@ -165,70 +163,6 @@ TEST_CASE("the batched pre-integrated kernel equals the scalar kernel through op
     INFO((shaded ? "shaded" : "unshaded") << ": " << runs << " runs, max difference " << worst);
     CHECK(runs > 500);
     CHECK(worst < 1e-5);
-  }
-}
-#endif
-
-#ifdef PVR_HAVE_PREINT_LANES
-// Identity: a ray's batched pre-integrated runs that go on from where the
-// last one stopped, with the window carried (kernel::PreintCarry, as a
-// ray's walk takes chunk after chunk of a visible stretch), composite what
-// one run over the whole stretch does: runs of 1 to 17 segments, so that
-// the carry follows full and partial batches (one segment long included),
-// through opacity 1, empty cells and NaN voxels. They differ only in
-// where batches begin (each batch is composited before it joins the ray),
-// 1e-6 at most; a window carried a lane off would put a wrong scalar into
-// the next segments (1e-3 and more).
-TEST_CASE("batched pre-integrated runs carried on from one to the next equal one run", "[preintegration]") {
-  const GridGeometry grid = cubeGrid(48);
-  auto field = [](Vec3 q) {
-    if (q.x >= 30 && q.x <= 31) return double(NAN);
-    return 0.5 + 0.7 * std::sin(q.x * 0.21) * std::cos(q.y * 0.13 + q.z * 0.07);
-  };
-  const Brick volume = makeVolume(grid, ScalarType::kFloat32, field);
-  const TransferFunctionSpec tf = mixedTransfer();
-  const Vec3 c = grid.center();
-  const Camera camera = makeCamera(Projection::kPerspective, c - normalize(Vec3{1, 0.35, 0.2}) * 80.0, c,
-                                   {0, 0, 1}, 40, 16, 16);
-  const std::int64_t lengths[] = {1, 2, 3, 5, 7, 8, 9, 13, 16, 17, 1, 1, 4};
-  for (bool shaded : {false, true}) {
-    const RenderOptions o = makeOptions(0.7, true, shaded);
-    const PreintegratedKernel setup(volume, tf, o);
-    KernelParams p = setup.params();
-    p.earlyTermination = 2;  // never: both composite every segment
-    double worst = 0;
-    int rays = 0, carried = 0;
-    setup.forEachRay(camera, grid, o.step, [&](const RaySetup& ray, std::int64_t first, std::int64_t last) {
-      if (last - first < 30) return;
-      const std::int64_t from = first + 1, to = last - 1;
-      kernel::Accumulator whole, pieces;
-      std::uint64_t n1 = 0, n2 = 0;
-      kernel::PreintCarry carry;
-      auto run = [&](auto kernelShaded) {
-        constexpr bool kShaded = decltype(kernelShaded)::value;
-        std::int64_t start = from;
-        kernel::runBatchedPreintegrated<float, kShaded>(p, ray, start, to, whole, n1);
-        REQUIRE(start == to);
-        for (std::int64_t at = from, i = 0; at < to; ++i) {
-          const std::int64_t end = std::min(to, at + lengths[i % std::size(lengths)]);
-          carried += carry.next == at;
-          kernel::runBatchedPreintegrated<float, kShaded>(p, ray, at, end, pieces, n2, &carry);
-          REQUIRE(at == end);
-          REQUIRE(carry.next == end);
-        }
-      };
-      if (shaded) run(std::true_type{});
-      else run(std::false_type{});
-      REQUIRE(n1 == n2);
-      worst = std::max({worst, std::abs(whole.r - pieces.r), std::abs(whole.g - pieces.g),
-                        std::abs(whole.b - pieces.b), std::abs(whole.a - pieces.a)});
-      ++rays;
-    });
-    INFO((shaded ? "shaded" : "unshaded") << ": " << rays << " rays, " << carried << " runs carried on, max difference "
-                                          << worst);
-    CHECK(rays > 100);
-    CHECK(carried > 1000);
-    CHECK(worst < 1e-6);
   }
 }
 #endif
