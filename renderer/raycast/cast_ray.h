@@ -4,9 +4,6 @@
 // raycaster.cpp; nothing in here branches on configuration at run time.
 #pragma once
 
-#include <type_traits>
-#include <variant>
-
 #include "kernel.h"
 #include "kernel_batch.h"
 #include "preint_lighting.h"
@@ -122,11 +119,9 @@ inline bool runEnd(const KernelParams& p, const RaySetup& ray, const ChordEnds& 
 
 // Samples [start, exit) of a visible run: the chord's end samples by
 // runEnd, the others in one loop. Returns true at early termination.
-// Pre-integrated, `carry` (may be null) is the ray's PreintCarry.
 template <typename T, bool kShaded, bool kPreintegrated>
 inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds& ends,
-                    std::int64_t start, std::int64_t exit, Accumulator& acc, std::uint64_t& samples,
-                    [[maybe_unused]] PreintCarry* carry = nullptr) {
+                    std::int64_t start, std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
   if (start == ends.first && start < exit) {
     if (runEnd<T, kShaded, kPreintegrated>(p, ray, ends, start, acc, samples)) return true;
     ++start;
@@ -136,7 +131,7 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
 #ifdef PVR_HAVE_BATCH_KERNEL
     if (p.indices32) {
       if constexpr (kPreintegrated) {
-        if (runBatchedPreintegrated<T, kShaded>(p, ray, start, body, acc, samples, carry)) return true;
+        if (runBatchedPreintegrated<T, kShaded>(p, ray, start, body, acc, samples)) return true;
       } else {
         if (runBatched<T, kShaded>(p, ray, start, body, acc, samples)) return true;
       }
@@ -232,9 +227,7 @@ class RayWalk {
     // sample before this run was skipped, its segment ends in here.
     std::int64_t start = k_;
     if constexpr (kPreintegrated) start = (done_ < k_) ? std::max(first_, k_ - 1) : k_;
-    PreintCarry* carry = nullptr;
-    if constexpr (kPreintegrated) carry = &carry_;
-    if (runSpan<T, kShaded, kPreintegrated>(p, ray, ends_, start, exit, acc_, out.samples, carry)) return finish(out);
+    if (runSpan<T, kShaded, kPreintegrated>(p, ray, ends_, start, exit, acc_, out.samples)) return finish(out);
     done_ = exit;
     k_ = exit;
     return k_ <= end_ || finish(out);
@@ -254,8 +247,6 @@ class RayWalk {
   CubeExit cube_;
   float o_[3], d_[3];  // the ray's origin and step in float, as the samples'
   Accumulator acc_;
-  // Pre-integrated: where the last batched run stopped (kernel_batch.h).
-  [[no_unique_address]] std::conditional_t<kPreintegrated, PreintCarry, std::monostate> carry_;
 };
 
 }  // namespace kernel

@@ -190,26 +190,6 @@ template <typename T>
 }
 #endif
 
-#ifdef PVR_HAVE_PREINT_LANES
-// Where a ray's batched pre-integrated run stopped: the window of samples
-// and the front end at sample `next`, so that the ray's next run, when it
-// starts there (the walk's next chunk of a visible stretch), goes on with
-// them instead of reading three samples again and looking the front end up
-// in scalar double (a fifth of an unshaded pre-integrated frame went to that
-// set-up, taken once per chunk of 16 or 32 samples). Every value in it is a
-// function of the sample indices alone (positions k d + o, the same
-// formulas in every batch), so going on equals starting afresh.
-struct alignas(64) PreintCarry {
-  preint::Ends8 before;                 // lane 7: the front end at `next`
-  __m256 carried, carriedLo, carriedHi;  // as runBatchedPreintegrated's window
-  float frontNode = 0;
-  bool frontStale = false;
-  std::int64_t next = INT64_MIN;  // the sample these are at; INT64_MIN: none
-};
-#else
-struct PreintCarry {};
-#endif
-
 // Pre-integrated segments [s, s + 1) for s in [start, exit), eight at a
 // time: the scalars at s + 2 .. s + 9 in one batch, the eight corrected
 // nodes s + 1 .. s + 8 (curvedNode()) in another, the eight segments
@@ -218,13 +198,10 @@ struct PreintCarry {};
 // and are not composited) and `start` ends at `exit`; without, the
 // segments are integrated per lane, eight at a time while eight remain, and
 // the caller takes the rest one at a time. `start` advances past what was
-// done. `carry` (may be null) holds the window where the ray's previous run
-// stopped, taken when it stopped at `start`, and gets this run's.
-// Returns true at the early-termination opacity.
+// done. Returns true at the early-termination opacity.
 template <typename T, bool kShaded>
 inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
-                                    std::int64_t exit, Accumulator& acc, std::uint64_t& samples,
-                                    [[maybe_unused]] PreintCarry* carry = nullptr) {
+                                    std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
 #ifdef PVR_HAVE_PREINT_LANES
   constexpr std::int64_t kFullBatchesOnly = 0;
 #else
@@ -258,13 +235,8 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   // start + 6 in one batch; the front node at `start`, and the sample at
   // start + 1 and its range for the first batch's first node.
   preint::End frontEnd;
-  float frontScalar = 0;
-#ifdef PVR_HAVE_PREINT_LANES
-  const bool goOn = carry && carry->next == start;
-#else
-  constexpr bool goOn = false;
-#endif
-  if (!goOn) {
+  float frontScalar;
+  {
     alignas(32) float first[8], firstLo[8], firstHi[8];
     __m256 lo8, hi8;
     _mm256_store_ps(first, aroundBatch(v, p, o, d, start - 1, lo8, hi8));
@@ -279,11 +251,7 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   }
   // On to the next batch, `count` segments done: the two samples before
   // its first node carried over.
-  int lastCount = 8;  // segments of the last batch
-  __m256 previous = _mm256_setzero_ps();  // the window before the last batch
   auto advance = [&](std::int64_t s, int count, __m256 x, __m256 xLo, __m256 xHi) __attribute__((always_inline)) {
-    lastCount = count;
-    previous = carried;
     carried = x;
     carriedLo = xLo;
     carriedHi = xHi;
@@ -293,60 +261,9 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
 #ifdef PVR_HAVE_PREINT_LANES
   // Lane 7 of `before`: the next segment's front end, at node frontNode
   // (stale after a batch of empty cells).
-  preint::Ends8 before;
+  preint::Ends8 before = preint::broadcast(frontEnd);
   float frontNode = frontScalar;
   bool frontStale = false;
-  if (goOn) {
-    before = carry->before;
-    carried = carry->carried;
-    carriedLo = carry->carriedLo;
-    carriedHi = carry->carriedHi;
-    frontNode = carry->frontNode;
-    frontStale = carry->frontStale;
-  } else {
-    before = preint::broadcast(frontEnd);
-  }
-  // The last batch's window, kept for the ray's next run (PreintCarry).
-  // After a partial batch of `count` segments the window's lanes are
-  // count - 8 lanes short of where a full batch leaves them: moved up, so
-  // that lane 7 holds what lane count - 1 does (a batch's lanes beyond
-  // `exit` hold the samples and nodes of those indices, read and corrected
-  // as the next run would).
-  auto keep = [&](int count) __attribute__((always_inline)) {
-    if (!carry) return;
-    carry->next = start;
-    if (count == 8) {
-      carry->before = before;
-      carry->carried = carried;
-      carry->carriedLo = carriedLo;
-      carry->carriedHi = carriedHi;
-      carry->frontNode = frontNode;
-      carry->frontStale = frontStale;
-      return;
-    }
-    const __m256i up = _mm256_add_epi32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), _mm256_set1_epi32(count - 8));
-    const __m256i clampedUp = _mm256_max_epi32(up, _mm256_setzero_si256());
-    carry->carried = _mm256_permutevar8x32_ps(carried, clampedUp);
-    // One segment: the sample at `start` is the previous window's last.
-    if (count == 1) carry->carried = _mm256_blend_ps(carry->carried, _mm256_permute_ps(previous, 0xFF), 0x40);
-    carry->carriedLo = _mm256_permutevar8x32_ps(carriedLo, clampedUp);
-    carry->carriedHi = _mm256_permutevar8x32_ps(carriedHi, clampedUp);
-    const __m512i up64 = _mm512_maskz_cvtepi32_epi64(preint::kAll, clampedUp);
-    auto move = [&](__m512d x) __attribute__((always_inline)) { return _mm512_maskz_permutexvar_pd(preint::kAll, up64, x); };
-    preint::Ends8& b = carry->before;
-    b.x = move(before.x);
-    b.tau = move(before.tau);
-    b.T = move(before.T);
-    b.M = move(before.M);
-    b.O = move(before.O);
-    b.opaque = move(before.opaque);
-    for (int c = 0; c < 3; ++c) {
-      b.K[c] = move(before.K[c]);
-      b.k[c] = move(before.k[c]);
-    }
-    carry->frontNode = frontNode;
-    carry->frontStale = frontStale;
-  };
 #endif
   for (std::int64_t s = start; s + kFullBatchesOnly < exit; s += 8) {
     // The samples at s + 2 .. s + 9 (after), and at s .. s + 7 and s + 1 .. s + 8.
@@ -374,7 +291,7 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     // A batch whose nodes all lie in empty cells integrates nothing: skip
     // the table, count the samples; the front end is looked up again only
     // when a batch needs it.
-    const float nextFront = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(node, _mm256_set1_epi32(count - 1)));
+    const float nextFront = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(node, _mm256_set1_epi32(7)));
     if (preint::allEmpty(p.preint, node, frontNode)) {
       frontStale = true;
       frontNode = nextFront;
@@ -469,18 +386,9 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     advance(s, count, after, lo8, hi8);
     if (acc.a >= p.earlyTermination) return true;
   }
-#ifdef PVR_HAVE_PREINT_LANES
-  keep(lastCount);
-#endif
   return false;
 }
 
 }  // namespace pvr::core::kernel
 
-#endif
-
-#ifndef PVR_HAVE_BATCH_KERNEL
-namespace pvr::core::kernel {
-struct PreintCarry {};  // nothing to carry without the batched kernel
-}  // namespace pvr::core::kernel
 #endif
