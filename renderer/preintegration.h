@@ -59,6 +59,13 @@ struct PreintegralTables {
                                                // test for a batch of empty segments)
   int entries = 0;
   float scale = 0, offset = 0;             // table coordinate = scalar * scale + offset
+  // The empty ends, in table coordinates, with a cell of margin for a
+  // coordinate's float rounding: a batch whose ends all lie below
+  // `clearBelow`, or all at or above `clearAbove`, integrates nothing
+  // (preint::allClear()). With no visible cell, every finite coordinate is
+  // below clearBelow.
+  float clearBelow = -INFINITY, clearAbove = INFINITY;
+  bool gaps = true;  // empty cells between the first visible cell and the last
 };
 
 namespace preint {

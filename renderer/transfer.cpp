@@ -150,6 +150,26 @@ PreintegratedTable::PreintegratedTable(const TransferFunctionSpec& tf) {
     const bool visible = a.tau > 0 || b.tau > 0 || a.opaque > 0 || b.opaque > 0;
     visibleBelow_[i] = visibleBelow_[i - 1] + (visible ? 1 : 0);
   }
+  // The empty ends (PreintegralTables::clearBelow, clearAbove): allEmpty()
+  // (preint_lanes.h) finds cells [cell(lo) - 1, cell(hi) + 1] empty, cell(x)
+  // = min(int(clamp(x, 0, n - 1)), n - 2), when cell(hi) <= first - 2, which
+  // for coordinates is hi < first - 1 (first >= 2), or when cell(lo) >=
+  // last + 2, which is lo >= last + 2 (last + 2 <= n - 2). Without empty
+  // cells between first and last, those are the only empty batches.
+  int first = -1, last = -1;  // visible cells
+  for (int i = 0; i + 1 < n; ++i)
+    if (visibleBelow_[i + 1] > visibleBelow_[i]) {
+      if (first < 0) first = i;
+      last = i;
+    }
+  if (first < 0) {
+    clearBelow_ = INFINITY;
+    gaps_ = false;
+  } else {
+    clearBelow_ = first >= 2 ? float(first - 1) : -INFINITY;
+    clearAbove_ = last + 2 <= n - 2 ? float(last + 2) : INFINITY;
+    gaps_ = int(visibleBelow_[last + 1] - visibleBelow_[first]) < last - first + 1;
+  }
   // The nearest opaque node at or below each node, then at or above it.
   for (int i = 1; i < n; ++i)
     if (cells_[i].opaque == 0) opaqueColour_[2 * std::size_t(i)] = opaqueColour_[2 * std::size_t(i - 1)];
@@ -166,6 +186,9 @@ PreintegralTables PreintegratedTable::tables() const {
   t.entries = int(cells_.size());
   t.scale = scale_;
   t.offset = offset_;
+  t.clearBelow = clearBelow_;
+  t.clearAbove = clearAbove_;
+  t.gaps = gaps_;
   return t;
 }
 

@@ -92,6 +92,8 @@ class PreintegratedTable {
   std::vector<PreintegralCell> cells_;
   std::vector<std::uint32_t> visibleBelow_;
   std::vector<Rgba> opaqueColour_;
+  float clearBelow_ = -INFINITY, clearAbove_ = INFINITY;  // PreintegralTables
+  bool gaps_ = true;
 };
 
 }  // namespace pvr::core

@@ -294,7 +294,8 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     // the table, count the samples; the front end is looked up again only
     // when a batch needs it.
     const float nextFront = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(node, _mm256_set1_epi32(7)));
-    if (preint::allEmpty(p.preint, node, frontNode)) {
+    if (preint::allClear(p.preint, node, frontNode) ||
+        (p.preint.gaps && preint::allEmpty(p.preint, node, frontNode))) {
       frontStale = true;
       frontNode = nextFront;
       advance(s, count, after, lo8, hi8);

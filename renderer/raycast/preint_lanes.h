@@ -122,6 +122,23 @@ struct Ends8 {
   return t.visibleBelow[final + 1] == t.visibleBelow[first];
 }
 
+// True when the eight scalars and `front` all lie in the transfer
+// function's empty low end, or all in its empty high end
+// (PreintegralTables::clearBelow, clearAbove): where the table has no empty
+// cells between visible ones, exactly allEmpty(), lane by lane and without
+// its reductions across the lanes and scalar clamps, whose chain of
+// dependent instructions before the batch's branch was a fifth of an
+// unshaded pre-integrated frame.
+[[gnu::always_inline]] inline bool allClear(const PreintegralTables& t, __m256 scalar, float front) {
+  const __m256 scale = _mm256_set1_ps(t.scale), offset = _mm256_set1_ps(t.offset);
+  const __m256 x = _mm256_fmadd_ps(scalar, scale, offset);
+  const __m256 f = _mm256_fmadd_ps(_mm256_set1_ps(front), scale, offset);
+  const __m256 below = _mm256_set1_ps(t.clearBelow), above = _mm256_set1_ps(t.clearAbove);
+  const int low = _mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(x, below, _CMP_LT_OQ), _mm256_cmp_ps(f, below, _CMP_LT_OQ)));
+  const int high = _mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(x, above, _CMP_GE_OQ), _mm256_cmp_ps(f, above, _CMP_GE_OQ)));
+  return low == 0xFF || high == 0xFF;
+}
+
 // The eight ends before these: lane 0 from lane 7 of `before`, lane j from
 // lane j - 1 of `e` (the back end of one segment is the front of the next).
 [[gnu::always_inline]] inline Ends8 fronts(const Ends8& before, const Ends8& e) {

@@ -49,6 +49,63 @@ TEST_CASE("the lanes expm1 is the library expm1", "[preintegration]") {
   }
 }
 
+// Identity: allClear() (the empty ends, lane by lane) never calls a batch
+// empty that allEmpty() (the prefix count of visible cells over the
+// batch's range) does not, and where the transfer function has no empty
+// cells between visible ones (PreintegralTables::gaps false) the two agree
+// on every batch. Scalars are drawn across the control points, beyond
+// them, and at and around the clear ends' limits (where a coordinate's
+// rounding decides). Transfer functions: clear at both ends, clear low
+// end only, visible from the first node, with a gap, and all clear.
+TEST_CASE("a batch in the transfer function's empty ends is empty by either test", "[preintegration]") {
+  auto ramp = [](std::vector<TransferPoint> points) {
+    TransferFunctionSpec tf;
+    tf.points = std::move(points);
+    tf.unitDistance = 1.0;
+    return tf;
+  };
+  const TransferFunctionSpec tfs[] = {
+      ramp({{0.0, 0, 0, 0, 0}, {0.3, 0.1, 0.2, 0.9, 0}, {0.5, 1.0, 0.8, 0.3, 0.6}, {0.7, 0.2, 0.2, 0.2, 0}, {1.0, 0, 0, 0, 0}}),
+      ramp({{0.0, 0, 0, 0, 0}, {0.2, 0.1, 0.2, 0.9, 0}, {1.0, 0.9, 0.9, 0.9, 0.3}}),
+      ramp({{0.0, 0.5, 0.5, 0.5, 0.2}, {0.6, 0.1, 0.2, 0.9, 0}, {1.0, 0, 0, 0, 0}}),
+      mixedTransfer(),
+      ramp({{0.0, 0, 0, 0, 0}, {1.0, 1, 1, 1, 0}})};
+  std::mt19937 random(7);
+  for (int which = 0; which < int(std::size(tfs)); ++which) {
+    const PreintegratedTable table(tfs[which]);
+    const PreintegralTables t = table.tables();
+    INFO("transfer function " << which << ", clear below " << t.clearBelow << ", at or above " << t.clearAbove);
+    CHECK(t.gaps == (which == 3));
+    // Scalars whose table coordinates lie at a limit, a rounding either side, or anywhere.
+    std::vector<float> limits;
+    for (float x : {t.clearBelow, t.clearAbove})
+      if (std::isfinite(x))
+        for (float dx : {-1.5f, -1.0f, -0.5f, -1e-3f, 0.0f, 1e-3f, 0.5f, 1.0f, 1.5f})
+          limits.push_back((x + dx - t.offset) / t.scale);
+    std::uniform_real_distribution<float> anywhere(-0.2f, 1.2f);
+    std::uniform_int_distribution<int> pick(0, 3);
+    int clear = 0, empty = 0;
+    for (int trial = 0; trial < 200000; ++trial) {
+      // Batches that stay near one value, so that some lie wholly in an end.
+      const float centre = limits.empty() || pick(random) == 0
+                               ? anywhere(random)
+                               : limits[std::size_t(random() % limits.size())];
+      std::uniform_real_distribution<float> near(-0.02f, 0.02f);
+      alignas(32) float s[8];
+      for (float& x : s) x = pick(random) == 0 ? centre : centre + near(random);
+      const float front = centre + near(random);
+      const __m256 scalars = _mm256_load_ps(s);
+      const bool byEnds = preint::allClear(t, scalars, front), byCount = preint::allEmpty(t, scalars, front);
+      clear += byEnds;
+      empty += byCount;
+      if (byEnds) REQUIRE(byCount);
+      if (!t.gaps) REQUIRE(byEnds == byCount);
+    }
+    INFO(clear << " batches clear by the ends, " << empty << " empty by the count");
+    if (which != 2) CHECK(clear > 1000);
+  }
+}
+
 // Identity: segments() of eight (front, back) pairs is segment() of each
 // pair, the opaque lanes flagged rather than coloured; the lanes use the
 // reciprocal estimate refined twice and an FMA where segment() divides,
