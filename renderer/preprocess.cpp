@@ -417,19 +417,14 @@ std::shared_ptr<FineHistogram> countFineKeys(ScalarType type, const NodeBox& sto
                                std::size_t(counted.lo.x - stored.lo.x),
                            std::size_t(counted.extent(0)));
     };
-    // Chunks of slabs, a few per thread so uneven chunks balance, into one
-    // counter per thread: a 16-bit counter is 512 KiB to clear and add up.
-    const std::int64_t slabs = counted.extent(2);
-    const std::int64_t chunks = pool ? std::min<std::int64_t>(slabs, 4 * pool->size()) : 1;
+    // Chunks of slabs into one counter per thread: a 16-bit counter is
+    // 512 KiB to clear and add up.
     std::vector<std::optional<FineCounter<T>>> counters(std::size_t(pool ? pool->size() : 1));
-    auto runChunk = [&](std::size_t c, int worker) {
+    forChunks(std::size_t(counted.extent(2)), pool, [&](std::size_t z0, std::size_t z1, int worker) {
       auto& counter = counters[std::size_t(worker)];
       if (!counter) counter.emplace();
-      countSlabs(*counter, counted.lo.z + slabs * std::int64_t(c) / chunks,
-                 counted.lo.z + slabs * (std::int64_t(c) + 1) / chunks);
-    };
-    if (chunks > 1) pool->parallelFor(std::size_t(chunks), runChunk);
-    else runChunk(0, 0);
+      countSlabs(*counter, counted.lo.z + std::int64_t(z0), counted.lo.z + std::int64_t(z1));
+    });
     for (const auto& counter : counters)
       if (counter) counter->addTo(out->counts);
   });

@@ -11,6 +11,7 @@
 #include <functional>
 #include <mutex>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace pvr::core {
@@ -47,15 +48,21 @@ class ThreadPool {
 
 // Runs body(begin, end) over contiguous chunks of [0, n): a few chunks per
 // thread of the pool (so uneven chunks still balance), or the whole range
-// on the calling thread when there is no pool.
+// on the calling thread when there is no pool. A body taking a third
+// argument gets the worker running the chunk, in [0, pool->size()) (0
+// without a pool), for state of its own per thread.
 template <typename F>
 void forChunks(std::size_t n, ThreadPool* pool, F&& body) {
+  auto run = [&](std::size_t begin, std::size_t end, int worker) {
+    if constexpr (std::is_invocable_v<F&, std::size_t, std::size_t, int>) body(begin, end, worker);
+    else body(begin, end);
+  };
   const std::size_t chunks = pool ? std::min<std::size_t>(n, std::size_t(pool->size()) * 4) : 1;
   if (chunks <= 1) {
-    if (n > 0) body(std::size_t(0), n);
+    if (n > 0) run(std::size_t(0), n, 0);
     return;
   }
-  pool->parallelFor(chunks, [&](std::size_t c, int) { body(n * c / chunks, n * (c + 1) / chunks); });
+  pool->parallelFor(chunks, [&](std::size_t c, int worker) { run(n * c / chunks, n * (c + 1) / chunks, worker); });
 }
 
 }  // namespace pvr::core

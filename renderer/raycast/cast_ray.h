@@ -196,10 +196,7 @@ class RayWalk {
     // costs nothing more.
     k_ = first_;
     end_ = last_;
-    if (!clipToVisible(p, ray, k_, end_)) return false;
-    k_ = std::max(k_, span.from);
-    end_ = std::min(end_, span.to);
-    if (k_ > end_) return false;
+    if (!clipToWalk(p, ray, span, k_, end_)) return false;
     ends_ = chordEnds(p, ray, first_, last_);
     for (int a = 0; a < 3; ++a) {
       o_[a] = float(ray.origin[a]);

@@ -87,9 +87,7 @@ RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShif
   // the tile's span): the samples outside are in invisible macrocells,
   // transparent at every level as the empty space skipped below is.
   std::int64_t k = first, end = last;
-  if (!kernel::clipToVisible(p, ray, k, end)) return out;
-  k = std::max(k, span.from);
-  end = std::min(end, span.to);
+  if (!kernel::clipToWalk(p, ray, span, k, end)) return out;
   const kernel::ChordEnds ends = kernel::chordEnds(p, ray, first, last);
   // A coarse chunk has no chord end in it (blockLevel).
   const kernel::ChordEnds noEnds{-1, std::numeric_limits<std::int64_t>::max(), 0, 0};

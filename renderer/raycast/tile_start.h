@@ -107,6 +107,17 @@ struct TileSpan {
   std::int64_t to = std::int64_t(1e18);
 };
 
+// Narrows a ray's samples [first, last] in the brick to those its walk
+// must look at: inside the visible box (clipToVisible) and the tile's
+// span. False when none are left.
+inline bool clipToWalk(const KernelParams& p, const RaySetup& ray, const TileSpan& span, std::int64_t& first,
+                       std::int64_t& last) {
+  if (!clipToVisible(p, ray, first, last)) return false;
+  first = std::max(first, span.from);
+  last = std::min(last, span.to);
+  return first <= last;
+}
+
 // The span of rays[0, n), from marches of their fat ray through the
 // distance field inwards from both ends of where it crosses the visible
 // box (KernelParams::visibleLo): each ray may start its walk at `from` and
