@@ -69,7 +69,7 @@ class FineCounter {
   // Tables a repeating block is counted into: four for 8-bit data (4 KB in
   // all; eight measured no faster), two for the others (65536 keys each).
   static constexpr std::size_t kTables = sizeof(T) == 1 ? 4 : 2;
-  static constexpr std::size_t kKeys = std::size_t(1) << (sizeof(T) == 1 ? 8 : 16);  // fineKeyCount
+  static constexpr std::size_t kKeys = kFineKeys<T>;
   static constexpr std::uint64_t kMaxPending = std::numeric_limits<std::uint32_t>::max();
 
   // `flushEvery`: voxels counted into the 32-bit tables before they go to

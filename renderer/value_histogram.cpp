@@ -5,7 +5,15 @@
 
 namespace pvr::core {
 
-std::size_t fineKeyCount(ScalarType type) { return type == ScalarType::kUInt8 ? 256 : 65536; }
+std::size_t fineKeyCount(ScalarType type) {
+  switch (type) {
+    case ScalarType::kUInt8: return kFineKeys<std::uint8_t>;
+    case ScalarType::kUInt16: return kFineKeys<std::uint16_t>;
+    case ScalarType::kInt16: return kFineKeys<std::int16_t>;
+    case ScalarType::kFloat32: return kFineKeys<float>;
+  }
+  return kFineKeys<float>;
+}
 
 namespace {
 

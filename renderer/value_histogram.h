@@ -28,6 +28,7 @@ namespace pvr::core {
 inline constexpr int kHistogramBins = 256;
 
 // Fine keys of a scalar type: 256 for uint8, 65536 for the others.
+template <typename T> inline constexpr std::size_t kFineKeys = sizeof(T) == 1 ? 256 : 65536;
 std::size_t fineKeyCount(ScalarType type);
 
 // The fine key of a value of type T (finite for float).
