@@ -30,6 +30,7 @@
 #include <optional>
 #include <thread>
 
+#include "../proc_files.h"
 #include "camera.h"
 #include "computation_run.h"
 #include "frame_pixels.h"
@@ -947,12 +948,8 @@ TEST_CASE_METHOD(Fixture, "a rank killed mid-sequence: the handler side sees the
   job.expect<proto::ImageFrame>();
   // The ranks are mpirun's children; kill one that is not the master.
   std::vector<pid_t> ranks;
-  for (const auto& entry : fs::directory_iterator("/proc")) {
-    std::ifstream stat(entry.path() / "stat");
-    std::string pid, comm, state;
-    pid_t ppid = 0;
-    if (stat >> pid >> comm >> state >> ppid && ppid == job.pid()) ranks.push_back(std::stoi(pid));
-  }
+  for (const pid_t pid : pvr::testing::allPids())
+    if (const auto stat = pvr::testing::procStat(pid); stat && stat->parent == job.pid()) ranks.push_back(pid);
   REQUIRE(ranks.size() == 3);
   std::sort(ranks.begin(), ranks.end());
   REQUIRE(::kill(ranks.back(), SIGKILL) == 0);
@@ -966,11 +963,7 @@ TEST_CASE_METHOD(Fixture, "a rank killed mid-sequence: the handler side sees the
   CHECK(job.reap(30));
   // Gone, or a zombie waiting for init: nothing runs (mpirun reaps the
   // ranks it killed; their process groups are their own).
-  const auto running = [](pid_t pid) {
-    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-    std::string p, comm, state;
-    return bool(stat >> p >> comm >> state) && state != "Z";
-  };
+  const auto running = pvr::testing::processRuns;
   for (int i = 0; i < 100 && std::any_of(ranks.begin(), ranks.end(), running); ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   for (pid_t r : ranks) CHECK_FALSE(running(r));
@@ -999,26 +992,18 @@ void openSlowSession(Job& job, std::uint32_t ranks) {
   job.expect<proto::Ok>();
 }
 
-bool processRuns(pid_t pid) {
-  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-  std::string p, comm, state;
-  return bool(stat >> p >> comm >> state) && state != "Z";
-}
+using pvr::testing::processRuns;
 
 // The job's ranks by world rank: mpirun's children, each told its rank in
 // its environment (OMPI_COMM_WORLD_RANK).
 std::map<int, pid_t> rankPids(const Job& job) {
   std::map<int, pid_t> ranks;
-  for (const auto& entry : fs::directory_iterator("/proc")) {
-    std::ifstream stat(entry.path() / "stat");
-    std::string pid, comm, state;
-    pid_t ppid = 0;
-    if (!(stat >> pid >> comm >> state >> ppid) || ppid != job.pid()) continue;
-    std::ifstream environ(entry.path() / "environ", std::ios::binary);
-    const std::string env((std::istreambuf_iterator<char>(environ)), std::istreambuf_iterator<char>());
-    const std::string key = std::string("OMPI_COMM_WORLD_RANK=");
-    const auto at = env.find(std::string(1, '\0') + key);
-    if (at != std::string::npos) ranks[std::atoi(env.c_str() + at + 1 + key.size())] = std::stoi(pid);
+  for (const pid_t pid : pvr::testing::allPids()) {
+    const auto stat = pvr::testing::procStat(pid);
+    if (!stat || stat->parent != job.pid()) continue;
+    const std::string key = "OMPI_COMM_WORLD_RANK=";
+    for (const std::string& e : pvr::testing::procEntries(pid, "environ"))
+      if (e.rfind(key, 0) == 0) ranks[std::atoi(e.c_str() + key.size())] = pid;
   }
   return ranks;
 }

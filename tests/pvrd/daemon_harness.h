@@ -17,11 +17,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <thread>
 
+#include "../proc_files.h"
 #include "pvr_protocol.h"
 #include "secure_channel.h"
 
@@ -54,31 +56,20 @@ inline fs::path makeDataDir(const std::string& tag) {
 // Pids of mpirun and pvr-node processes started for this data directory.
 inline std::vector<pid_t> jobProcesses(const fs::path& dataDir) {
   std::vector<pid_t> pids;
-  for (const auto& e : fs::directory_iterator("/proc")) {
-    const pid_t pid = pid_t(std::atoi(e.path().filename().c_str()));
-    if (pid <= 0) continue;
-    std::ifstream in(e.path() / "cmdline", std::ios::binary);
-    std::string cmd((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const pid_t pid : pvr::testing::allPids()) {
+    std::string cmd = pvr::testing::procFile(pid, "cmdline");
     std::replace(cmd.begin(), cmd.end(), '\0', ' ');
-    if (cmd.find("--connect") != std::string::npos && cmd.find(dataDir.string()) != std::string::npos) {
-      std::ifstream stat(e.path() / "stat");
-      std::string s((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
-      const auto close = s.rfind(')');
-      if (close != std::string::npos && s.size() > close + 2 && s[close + 2] == 'Z') continue;  // zombie
+    if (cmd.find("--connect") != std::string::npos && cmd.find(dataDir.string()) != std::string::npos &&
+        pvr::testing::processRuns(pid))
       pids.push_back(pid);
-    }
   }
   return pids;
 }
 
 inline std::vector<pid_t> nodeProcesses(const fs::path& dataDir) {
   std::vector<pid_t> out;
-  for (pid_t p : jobProcesses(dataDir)) {
-    std::ifstream in("/proc/" + std::to_string(p) + "/comm");
-    std::string comm;
-    std::getline(in, comm);
-    if (comm.find("pvr-node") != std::string::npos) out.push_back(p);
-  }
+  for (pid_t p : jobProcesses(dataDir))
+    if (pvr::testing::procFile(p, "comm").find("pvr-node") != std::string::npos) out.push_back(p);
   return out;
 }
 
@@ -92,14 +83,7 @@ inline double secondsUntilJobGone(const fs::path& dataDir, double limit) {
   return -1;
 }
 
-// A /proc/PID file whose entries are separated by NUL bytes (cmdline,
-// environ), one string per entry.
-inline std::vector<std::string> procEntries(pid_t pid, const char* file) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/" + file, std::ios::binary);
-  std::vector<std::string> entries;
-  for (std::string entry; std::getline(in, entry, '\0');) entries.push_back(entry);
-  return entries;
-}
+using pvr::testing::procEntries;
 
 // The value of `name` in the environment process `pid` started with; "" if unset.
 inline std::string startEnvironmentValue(pid_t pid, const std::string& name) {
@@ -255,38 +239,56 @@ struct Client {
                                                      proto::kClientPurpose);
     writeRaw(channel->takeOutgoing());
   }
+  // Why the last next() returned nothing, for a failing test's report.
+  std::string ended;
   // The next message, or nullopt at end of stream or after `seconds`.
   std::optional<proto::Decoded> next(double seconds = 60) {
     const auto t = Clock::now();
     for (;;) {
       if (auto d = decoder.pop()) return d;
-      if (decoder.error() || since(t) > seconds) return std::nullopt;
+      if (decoder.error()) {
+        ended = "the replies did not decode: " + decoder.error()->text;
+        return std::nullopt;
+      }
+      if (since(t) > seconds) {
+        ended = "nothing came within " + std::to_string(seconds) + " s";
+        return std::nullopt;
+      }
       pollfd p{fd, POLLIN, 0};
       if (::poll(&p, 1, 100) <= 0) continue;
       std::uint8_t buf[65536];
       const ssize_t n = ::read(fd, buf, sizeof buf);
-      if (n <= 0) return std::nullopt;
+      if (n <= 0) {
+        ended = n == 0 ? "the peer closed the connection" : std::string("read: ") + std::strerror(errno);
+        return std::nullopt;
+      }
       if (!channel) {
         decoder.feed(std::span(buf, std::size_t(n)));
         continue;
       }
       channelFailure = channel->receive(std::span(buf, std::size_t(n)));
       writeRaw(channel->takeOutgoing());  // handshake replies, or the alert
-      if (channelFailure) return std::nullopt;
+      if (channelFailure) {
+        ended = "the secure channel failed: " + channelFailure->text;
+        return std::nullopt;
+      }
       decoder.feed(channel->takeIncoming());
     }
   }
   template <class T>
   T expect(double seconds = 60) {
     auto d = next(seconds);
+    INFO("waiting for " << T::kWire.name << ": " << ended);
     REQUIRE(d);
     if (const auto* e = std::get_if<proto::ErrorMessage>(&d->message)) FAIL("Error " << int(e->code) << ": " << e->text);
+    INFO("got " << proto::messageInfo(d->message).name);
     REQUIRE(std::holds_alternative<T>(d->message));
     return std::get<T>(d->message);
   }
   proto::ErrorMessage expectError(double seconds = 60) {
     for (;;) {
       auto d = next(seconds);
+      INFO("waiting for an Error: " << ended);
       REQUIRE(d);
       if (auto* e = std::get_if<proto::ErrorMessage>(&d->message)) return *e;
     }

@@ -10,6 +10,7 @@
 #include <thread>
 #include <variant>
 
+#include "../proc_files.h"
 #include "advertise.h"
 #include "auth.h"
 #include "catalog.h"
@@ -79,10 +80,7 @@ bool processGone(const fs::path& pidFile) {
   in >> pid;
   REQUIRE(pid > 0);
   for (int tries = 0; tries < 250; ++tries) {
-    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-    const std::string s((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
-    const auto close = s.rfind(')');
-    if (s.empty() || (close != std::string::npos && s.size() > close + 2 && s[close + 2] == 'Z')) return true;
+    if (!pvr::testing::processRuns(pid)) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return false;

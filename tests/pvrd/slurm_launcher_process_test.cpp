@@ -49,11 +49,8 @@ void expectQueued(Client& c, std::uint32_t id, const std::string& job, const std
 std::vector<pid_t> outermost(const std::vector<pid_t>& pids) {
   std::vector<pid_t> out;
   for (pid_t p : pids) {
-    std::ifstream stat("/proc/" + std::to_string(p) + "/stat");
-    std::string s((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
-    const auto close = s.rfind(')');
-    pid_t parent = 0;
-    if (close != std::string::npos) std::istringstream(s.substr(close + 4)) >> parent;  // ") S PPID"
+    const auto stat = pvr::testing::procStat(p);
+    const pid_t parent = stat ? stat->parent : 0;
     if (std::find(pids.begin(), pids.end(), parent) == pids.end()) out.push_back(p);
   }
   return out;
