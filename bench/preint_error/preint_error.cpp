@@ -225,7 +225,10 @@ struct Model {
       double lo, hi;
       segmentRange(ray, ta, tb, lo, hi);
       if (!table[0]->visible(lo, hi) && !table[1]->visible(lo, hi)) continue;
-      const bool onNodes = std::abs(ta / h - std::round(ta / h)) < 1e-9 && std::abs(tb / h - std::round(tb / h)) < 1e-9;
+      // The caster's chord-end segments (runSpan, runEnd), the entry to the
+      // first sample and the last sample to the exit, between raw samples;
+      // the others between curved nodes.
+      const bool onNodes = first <= last && ta >= (double(first) - 0.5) * h && tb <= (double(last) + 0.5) * h;
       const double ra = sample(ray, ta), rb = sample(ray, tb);
       double ca = ra, cb = rb, na = ra, nb = rb, mid = sample(ray, 0.5 * (ta + tb)), nm = mid;
       if (onNodes) {
