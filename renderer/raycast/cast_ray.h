@@ -130,10 +130,12 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
       // nodes. One segment from the entry to the second sample, up to two
       // steps long with the scalar linear along it, was the largest error
       // left where the volume's faces are not empty (CT head at step 1:
-      // RMSE 5.8e-3 against 5.0e-3; bench/results/preint_error.md).
+      // RMSE 5.8e-3 against 5.0e-3; bench/results/preint_error.md). It is
+      // not counted as a sample: the samples are the chord's, one a step.
+      std::uint64_t entry = 0;
       if (ends.head > 0 &&
           runSegment<T, kShaded, kPreintegrated>(p, ray, double(start), double(start) - ends.head, double(start),
-                                                 acc, samples))
+                                                 acc, entry))
         return true;
     } else {
       if (runEnd<T, kShaded, kPreintegrated>(p, ray, ends, start, acc, samples)) return true;
