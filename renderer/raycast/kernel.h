@@ -386,9 +386,11 @@ inline bool clipToVisible(const KernelParams& p, const RaySetup& r, std::int64_t
 // against its samples. Each sample stands for a segment one step long (the
 // plain kernel: centred on the sample; pre-integration: from the sample to
 // the next). At the two ends of the chord those segments are stretched or
-// cut to the chord, so that together they cover it exactly and a
-// homogeneous medium integrates to 1 - exp(-tau L) for any step. The ends
-// depend on the ray and the grid alone: every brick finds the same ones.
+// cut to the chord (pre-integration: the entry to the first sample is a
+// segment of its own, and the last sample's segment is cut at the exit),
+// so that together they cover it exactly and a homogeneous medium
+// integrates to 1 - exp(-tau L) for any step. The ends depend on the ray
+// and the grid alone: every brick finds the same ones.
 struct ChordEnds {
   std::int64_t first = 0, last = -1;  // the first and last samples in the domain
   double head = 0;  // steps from the chord's entry to sample `first`, in [0, 1]
