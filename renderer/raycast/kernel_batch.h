@@ -96,7 +96,10 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
     return out;
   };
   // The next batch's voxels are fetched before this batch's transparency
-  // test: a mispredicted skip then no longer discards the fetch in flight.
+  // test: a mispredicted skip then no longer discards the fetch in flight
+  // (peer scene: 15 % less CPU time, bench/results/plain.txt). Fetched only
+  // while eight more samples remain, so nothing past the run is read; the
+  // batch fetched ahead of one that terminates the ray is dropped.
   Batch next = reconstruct(start);
   for (std::int64_t s = start; s + 8 <= exit; s += 8, start = s) {
     const Batch batch = next;
