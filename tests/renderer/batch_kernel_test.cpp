@@ -337,6 +337,59 @@ TEST_CASE("early termination inside a batch stops at the batch's end", "[raycast
   }
 }
 
+// Each batch's voxels are fetched while the batch before it is classified
+// (kernel_batch.h): the batch fetched ahead is taken only when eight more
+// samples remain, and one fetched ahead of the batch that terminates the
+// ray is dropped. Runs of every length from 8 to 40 samples, starting at
+// every offset within a cell pair: the batches take the whole batches and
+// stop where they end, with what the scalar loop composites.
+TEST_CASE("batches fetched ahead are taken for every run length", "[raycast]") {
+  const GridGeometry grid = cubeGrid(33);
+  const Brick wave = makeVolume(grid, ScalarType::kUInt8,
+                                [](Vec3 q) { return 127.5 + 120 * std::sin(q.x * 0.7) * std::cos(q.y * 0.2); });
+  const TransferFunctionSpec tf = transfer({{0.0, 0, 0, 0, 0}, {60.0, 0, 0, 0, 0}, {128.0, 0.9, 0.4, 0.2, 0.3},
+                                            {200.0, 0.1, 0.6, 0.9, 0.05}, {255.0, 0.5, 0.5, 0.5, 0.2}});
+  const RenderOptions o = makeOptions(0.31);
+  Setup s(wave, tf, o);
+  REQUIRE(s.p.clearBelow > 0);
+  const RaySetup ray = alongX(9.5, 16.25, o.step);
+  std::int64_t first = 0, last = 0;
+  REQUIRE(kernel::sampleRange(s.p, ray, first, last));
+  REQUIRE(last - first > 48);
+  for (std::int64_t shift = 0; shift < 7; ++shift)
+    for (std::int64_t length = 8; length <= 40; ++length) {
+      const std::int64_t from = first + shift, to = from + length;
+      const Run a = scalarRun<std::uint8_t, false>(s.p, ray, from, to);
+      Run b;
+      std::int64_t start = from;
+      REQUIRE_FALSE(kernel::runBatched<std::uint8_t, false>(s.p, ray, start, to, b.acc, b.samples));
+      INFO("shift " << shift << ", length " << length);
+      CHECK(start == from + length / 8 * 8);
+      CHECK(b.samples == std::uint64_t(length / 8 * 8));
+      REQUIRE_FALSE(kernel::runScalar<std::uint8_t, false, false>(s.p, ray, start, to, b.acc, b.samples));
+      CHECK(a.samples == b.samples);
+      CHECK(difference(a.acc, b.acc) < 1e-6);
+    }
+  // Terminated by the first batch of a longer run: the batch fetched
+  // ahead is dropped, the run stops after eight samples.
+  RenderOptions early = o;
+  early.earlyTermination = 0.05;
+  Setup e(wave, tf, early);
+  int terminated = 0;
+  for (std::int64_t from = first; from + 24 <= last; ++from) {
+    Run b;
+    std::int64_t start = from;
+    if (!kernel::runBatched<std::uint8_t, false>(e.p, ray, start, from + 24, b.acc, b.samples)) continue;
+    ++terminated;
+    const Run a = scalarRun<std::uint8_t, false>(s.p, ray, from, start);  // not terminated: the whole batches
+    CHECK(b.acc.a >= 0.05);
+    CHECK((start - from) % 8 == 0);
+    CHECK(b.samples == std::uint64_t(start - from));
+    CHECK(difference(a.acc, b.acc) < 1e-6);
+  }
+  CHECK(terminated > 10);
+}
+
 }  // namespace pvr::core
 
 #endif
