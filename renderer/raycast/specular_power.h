@@ -16,8 +16,8 @@
 // max(x, floor[k]) (floor[k] 0 where bit k of n is set, 1 where clear:
 // KernelParams::powerFloor), so no lane and no sample branches on n.
 // Steps over leading clear bits keep r = 1 exactly, so a kernel of b steps
-// gives the same bits for every n below 2^b (pickKernel() instantiates
-// b = kPowerBits only: 5 steps for n = 24 measured no faster); and no partial power is smaller than the result,
+// gives the same bits for every n below 2^b (pickKernel() rounds b up to
+// a few instantiations); and no partial power is smaller than the result,
 // so no step falls into denormals (slow) unless x^n itself does.
 //
 // Accuracy: a squaring doubles the relative error it is given and adds a
