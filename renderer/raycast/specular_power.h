@@ -2,7 +2,9 @@
 // (Blinn-Phong's (n.h)^shininess, x in [0, 1]), and how the shaded kernel
 // is told which way to raise it: a template parameter, kPower, chosen once
 // per frame where the kernel is picked (raycaster.cpp: pickKernel()), so
-// the per-sample loop does not branch on the shininess.
+// the per-sample loop does not branch on the shininess. Pre-integrated
+// kernels, the kernel that picks the step per region and the kernel of
+// several volumes keep the table.
 //
 //   kTablePower (0)   the interpolated table of 2048 values (kernel_setup.cpp:
 //                     specularTable()), for any shininess;
