@@ -53,8 +53,13 @@ namespace pvr::core::kernel {
 template <typename T>
 [[gnu::always_inline]] inline void gradient8(const T* v, const KernelParams& p, const __m256 u[3], unsigned wanted,
                                              __m256 g[3]) {
+  // Every lane where the interior form applies is computed by it, wanted
+  // or not: its loads then hang on the positions alone, not on `wanted`
+  // (the classification's chain), and start while the batch is still
+  // being reconstructed and classified.
   __m256i cell[3];
-  const unsigned interior = wanted & unsigned(_mm256_movemask_ps(interiorLanes8(p, u, cell)));
+  const __m256i inLane = _mm256_castps_si256(interiorLanes8(p, u, cell));
+  const unsigned interior = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(inLane)));
   if (interior) {
     // Lanes not computed here read around the first lane that is, so every
     // load stays in the stored box.
@@ -62,9 +67,6 @@ template <typename T>
         _mm256_add_epi32(cell[0], _mm256_set1_epi32(std::int32_t(p.base))),
         _mm256_add_epi32(_mm256_mullo_epi32(cell[1], _mm256_set1_epi32(std::int32_t(p.strideY))),
                          _mm256_mullo_epi32(cell[2], _mm256_set1_epi32(std::int32_t(p.strideZ)))));
-    const __m256i inLane = _mm256_cmpgt_epi32(
-        _mm256_and_si256(_mm256_set1_epi32(int(interior)), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
-        _mm256_setzero_si256());
     const __m256i firstLane =
         _mm256_permutevar8x32_epi32(index0, _mm256_set1_epi32(__builtin_ctz(interior)));
     alignas(32) std::int32_t index[8];
