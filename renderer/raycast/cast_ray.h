@@ -1,6 +1,7 @@
 // castRay: march one ray through one brick, skipping invisible macrocells.
 //
-// Instantiated per scalar type, shading and pre-integration by
+// Instantiated per scalar type, shading, pre-integration and the way
+// shading raises the specular power (kPower, specular_power.h) by
 // raycaster.cpp; nothing in here branches on configuration at run time.
 #pragma once
 
@@ -15,7 +16,7 @@ namespace kernel {
 
 // Samples [start, exit) of a visible run, one at a time. Returns true when
 // the ray reached the early-termination opacity.
-template <typename T, bool kShaded, bool kPreintegrated>
+template <typename T, bool kShaded, bool kPreintegrated, int kPower = kTablePower>
 inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t start,
                       std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
   if (start >= exit) return false;  // the batched kernel did them all: no window to set up
@@ -51,7 +52,7 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
       if constexpr (kPreintegrated) {
         c = shadeSegment(v, p, ray, float(s), 1.0f, centre, spread, c);
       } else {
-        c = shade(v, p, ray, x0, x1, x2, c);
+        c = shade<T, kPower>(v, p, ray, x0, x1, x2, c);
       }
     }
     acc.addBehind(c);
@@ -68,7 +69,7 @@ inline bool runScalar(const KernelParams& p, const RaySetup& ray, std::int64_t s
 // `from` and `to` lie within a step of it, so every read stays within the
 // ghost layers (ghostLayers()). Returns true at early termination.
 // Out of line and cold: it runs at most twice per ray.
-template <typename T, bool kShaded, bool kPreintegrated>
+template <typename T, bool kShaded, bool kPreintegrated, int kPower = kTablePower>
 [[gnu::noinline, gnu::cold]] bool runSegment(const KernelParams& p, const RaySetup& ray,
                                              double at, double from, double to,
                                              Accumulator& acc, std::uint64_t& samples) {
@@ -97,7 +98,7 @@ template <typename T, bool kShaded, bool kPreintegrated>
   if constexpr (kShaded) {
     if (c.a > 0) {
       if constexpr (kPreintegrated) c = shadeSegment(v, p, ray, float(from), float(to - from), centre, spread, c);
-      else c = shade(v, p, ray, x[0], x[1], x[2], c);
+      else c = shade<T, kPower>(v, p, ray, x[0], x[1], x[2], c);
     }
   }
   if constexpr (!kPreintegrated) c = stretch(c, to - from);
@@ -107,7 +108,7 @@ template <typename T, bool kShaded, bool kPreintegrated>
 
 // Sample s at an end of the chord (see ChordEnds): its segment stretched or
 // cut to the chord.
-template <typename T, bool kShaded, bool kPreintegrated>
+template <typename T, bool kShaded, bool kPreintegrated, int kPower = kTablePower>
 inline bool runEnd(const KernelParams& p, const RaySetup& ray, const ChordEnds& ends,
                    std::int64_t s, Accumulator& acc, std::uint64_t& samples) {
   // Plain: the half steps around s; pre-integrated: s to s + 1 (the chord's
@@ -115,12 +116,12 @@ inline bool runEnd(const KernelParams& p, const RaySetup& ray, const ChordEnds& 
   const double before = kPreintegrated ? 0.0 : 0.5, after = kPreintegrated ? 1.0 : 0.5;
   const double from = double(s) - (s == ends.first && !kPreintegrated ? ends.head : before);
   const double to = double(s) + (s == ends.last ? ends.tail : after);
-  return runSegment<T, kShaded, kPreintegrated>(p, ray, double(s), from, to, acc, samples);
+  return runSegment<T, kShaded, kPreintegrated, kPower>(p, ray, double(s), from, to, acc, samples);
 }
 
 // Samples [start, exit) of a visible run: the chord's end samples by
 // runEnd, the others in one loop. Returns true at early termination.
-template <typename T, bool kShaded, bool kPreintegrated>
+template <typename T, bool kShaded, bool kPreintegrated, int kPower = kTablePower>
 inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds& ends,
                     std::int64_t start, std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
   if (start == ends.first && start < exit) {
@@ -134,11 +135,11 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
       // not counted as a sample: the samples are the chord's, one a step.
       std::uint64_t entry = 0;
       if (ends.head > 0 &&
-          runSegment<T, kShaded, kPreintegrated>(p, ray, double(start), double(start) - ends.head, double(start),
-                                                 acc, entry))
+          runSegment<T, kShaded, kPreintegrated, kPower>(p, ray, double(start), double(start) - ends.head,
+                                                         double(start), acc, entry))
         return true;
     } else {
-      if (runEnd<T, kShaded, kPreintegrated>(p, ray, ends, start, acc, samples)) return true;
+      if (runEnd<T, kShaded, kPreintegrated, kPower>(p, ray, ends, start, acc, samples)) return true;
       ++start;
     }
   }
@@ -149,15 +150,15 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
       if constexpr (kPreintegrated) {
         if (runBatchedPreintegrated<T, kShaded>(p, ray, start, body, acc, samples)) return true;
       } else {
-        if (runBatched<T, kShaded>(p, ray, start, body, acc, samples)) return true;
+        if (runBatched<T, kShaded, kPower>(p, ray, start, body, acc, samples)) return true;
       }
     }
 #endif
-    if (runScalar<T, kShaded, kPreintegrated>(p, ray, start, body, acc, samples)) return true;
+    if (runScalar<T, kShaded, kPreintegrated, kPower>(p, ray, start, body, acc, samples)) return true;
     start = body;
   }
   if (start == ends.last && start < exit)
-    return runEnd<T, kShaded, kPreintegrated>(p, ray, ends, start, acc, samples);
+    return runEnd<T, kShaded, kPreintegrated, kPower>(p, ray, ends, start, acc, samples);
   return false;
 }
 
@@ -183,7 +184,7 @@ namespace kernel {
 // one ray's steps in turn; castRays takes the steps of several rays by
 // turns, so that their chains of dependent arithmetic and loads a look-up
 // is (position, macrocell, distance, leap) overlap in the CPU.
-template <typename T, bool kShaded, bool kPreintegrated>
+template <typename T, bool kShaded, bool kPreintegrated, int kPower = kTablePower>
 class RayWalk {
  public:
   // Sets the walk up; false when the ray is done already (out holds its
@@ -202,7 +203,7 @@ class RayWalk {
                             p.mcFirst[a] + p.mcCount[a] - 1);
         out.hit = true;
         if (p.distance[macrocellIndex(p, m)] == 0)
-          runSegment<T, kShaded, kPreintegrated>(p, ray, mid, kIn, kOut, acc_, out.samples);
+          runSegment<T, kShaded, kPreintegrated, kPower>(p, ray, mid, kIn, kOut, acc_, out.samples);
         out.colour = acc_.rgba();
       }
       return false;
@@ -240,7 +241,7 @@ class RayWalk {
     // sample before this run was skipped, its segment ends in here.
     std::int64_t start = k_;
     if constexpr (kPreintegrated) start = (done_ < k_) ? std::max(first_, k_ - 1) : k_;
-    if (runSpan<T, kShaded, kPreintegrated>(p, ray, ends_, start, exit, acc_, out.samples)) return finish(out);
+    if (runSpan<T, kShaded, kPreintegrated, kPower>(p, ray, ends_, start, exit, acc_, out.samples)) return finish(out);
     done_ = exit;
     k_ = exit;
     return k_ <= end_ || finish(out);
@@ -266,10 +267,10 @@ class RayWalk {
 
 // One ray; its samples outside `span` lie in invisible macrocells
 // (tileSpan(), tile_start.h; by default nothing is known).
-template <typename T, bool kShaded, bool kPreintegrated>
+template <typename T, bool kShaded, bool kPreintegrated, int kPower = kernel::kTablePower>
 RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift, const kernel::TileSpan& span = {}) {
   RayResult out;
-  kernel::RayWalk<T, kShaded, kPreintegrated> walk;
+  kernel::RayWalk<T, kShaded, kPreintegrated, kPower> walk;
   if (walk.start(p, ray, mcShift, span, out))
     while (walk.step(p, ray, mcShift, out)) {
     }
@@ -279,10 +280,10 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift, const
 // Rays rays[0, n) into out[0, n), n <= kRaysAtOnce: their walks by
 // turns, a step of each (see RayWalk), each ray as castRay would take it
 // (with the same `span`).
-template <typename T, bool kShaded, bool kPreintegrated>
+template <typename T, bool kShaded, bool kPreintegrated, int kPower = kernel::kTablePower>
 void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan& span,
               RayResult* out) {
-  kernel::RayWalk<T, kShaded, kPreintegrated> walk[kRaysAtOnce];
+  kernel::RayWalk<T, kShaded, kPreintegrated, kPower> walk[kRaysAtOnce];
   bool going[kRaysAtOnce];
   int left = 0;
   for (int i = 0; i < n; ++i) {

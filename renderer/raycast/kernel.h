@@ -14,6 +14,7 @@
 
 #include "../image.h"
 #include "../preintegration.h"
+#include "specular_power.h"
 
 namespace pvr::core {
 
@@ -58,6 +59,9 @@ struct KernelParams {
   // Shading (world space).
   float ambient = 0, diffuse = 0, specular = 0, shininess = 1;
   const float* specularTable = nullptr;  // kSpecularTableSize values of x^shininess, x in [0, 1]
+  // A whole shininess's bits for the kernels that raise x^shininess by
+  // steps (specular_power.h): 0 where bit k is set, 1 where clear.
+  float powerFloor[kernel::kPowerBits] = {};
   // Quality chosen by error (step_levels.h, cast_ray_levels.h): the level
   // of each macrocell of StepLevels' layout, and per level l these
   // parameters with the table of a step of 2^l fine steps.
@@ -297,8 +301,9 @@ template <typename T>
 
 // Blinn-Phong with a central-difference gradient, two-sided. A zero or
 // undefined gradient (homogeneous or non-finite data) is lit head-on.
-// (shade_lanes.h lights eight samples of a batch alike.)
-template <typename T>
+// (shade_lanes.h lights eight samples of a batch alike.) kPower: how
+// nh^shininess is raised (specular_power.h).
+template <typename T, int kPower = kTablePower>
 [[gnu::always_inline]] inline Rgba shade(const T* v, const KernelParams& p, const RaySetup& ray, float u0, float u1,
                   float u2, Rgba c) {
   float g[3];
@@ -311,12 +316,16 @@ template <typename T>
     const float nl = std::fabs((g[0] * ray.light[0] + g[1] * ray.light[1] + g[2] * ray.light[2]) * inv);
     const float nh = std::fabs((g[0] * ray.halfway[0] + g[1] * ray.halfway[1] + g[2] * ray.halfway[2]) * inv);
     lit = p.ambient + p.diffuse * nl;
-    // nh^shininess from a table (raycaster.cpp): powf was a tenth of a
-    // shaded frame.
-    const float x = std::min(nh, 1.0f) * float(kSpecularTableSize - 1);
-    const int e = std::min(int(x), kSpecularTableSize - 2);
-    const float w = x - float(e);
-    spec = p.specular * (p.specularTable[e] + w * (p.specularTable[e + 1] - p.specularTable[e])) * c.a;
+    // nh^shininess by steps or from a table (raycaster.cpp): powf was a
+    // tenth of a shaded frame.
+    if constexpr (kPower == kTablePower) {
+      const float x = std::min(nh, 1.0f) * float(kSpecularTableSize - 1);
+      const int e = std::min(int(x), kSpecularTableSize - 2);
+      const float w = x - float(e);
+      spec = p.specular * (p.specularTable[e] + w * (p.specularTable[e + 1] - p.specularTable[e])) * c.a;
+    } else {
+      spec = p.specular * powerBySteps<kPower>(std::min(nh, 1.0f), p.powerFloor) * c.a;
+    }
   }
   return {c.r * lit + spec, c.g * lit + spec, c.b * lit + spec, c.a};
 }

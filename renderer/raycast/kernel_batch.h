@@ -39,8 +39,9 @@ namespace pvr::core::kernel {
 // (KernelParams::clearBelow, clearAbove) stops after the reconstruction;
 // the others are classified and composited with each other first, then
 // into the ray (kernel_batch_over.h). Returns true when the ray reached the
-// early-termination opacity, tested after each batch.
-template <typename T, bool kShaded>
+// early-termination opacity, tested after each batch. kPower: how shading
+// raises nh^shininess (specular_power.h).
+template <typename T, bool kShaded, int kPower = kTablePower>
 inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
                        std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
   if (start + 8 > exit) return false;
@@ -124,7 +125,7 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
     if constexpr (std::is_floating_point_v<T>) keepQuads(c, finite);
     if constexpr (kShaded) {
       // Light the visible samples, all eight lanes at once (shade_lanes.h).
-      shadeQuads(v, p, ray, batch.u, c);
+      shadeQuads<T, kPower>(v, p, ray, batch.u, c);
     }
     // Composite the batch, then the batch into the ray.
     gathered = addBehind4(gathered, overQuads(c));

@@ -99,6 +99,8 @@ void setOptions(KernelParams& p, const RenderOptions& options, const float* spec
   p.specular = float(options.shading.specular);
   p.shininess = float(options.shading.shininess);
   p.specularTable = specularTable;
+  if (kernel::powerBits(options.shading.shininess) != kernel::kTablePower)
+    kernel::setPowerFloor(int(options.shading.shininess), p.powerFloor);
 }
 
 std::vector<float> specularTable(double shininess) {

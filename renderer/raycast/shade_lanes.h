@@ -53,8 +53,13 @@ namespace pvr::core::kernel {
 template <typename T>
 [[gnu::always_inline]] inline void gradient8(const T* v, const KernelParams& p, const __m256 u[3], unsigned wanted,
                                              __m256 g[3]) {
+  // Every lane where the interior form applies is computed by it, wanted
+  // or not: its loads then hang on the positions alone, not on `wanted`
+  // (the classification's chain), and start while the batch is still
+  // being reconstructed and classified.
   __m256i cell[3];
-  const unsigned interior = wanted & unsigned(_mm256_movemask_ps(interiorLanes8(p, u, cell)));
+  const __m256i inLane = _mm256_castps_si256(interiorLanes8(p, u, cell));
+  const unsigned interior = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(inLane)));
   if (interior) {
     // Lanes not computed here read around the first lane that is, so every
     // load stays in the stored box.
@@ -62,9 +67,6 @@ template <typename T>
         _mm256_add_epi32(cell[0], _mm256_set1_epi32(std::int32_t(p.base))),
         _mm256_add_epi32(_mm256_mullo_epi32(cell[1], _mm256_set1_epi32(std::int32_t(p.strideY))),
                          _mm256_mullo_epi32(cell[2], _mm256_set1_epi32(std::int32_t(p.strideZ)))));
-    const __m256i inLane = _mm256_cmpgt_epi32(
-        _mm256_and_si256(_mm256_set1_epi32(int(interior)), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
-        _mm256_setzero_si256());
     const __m256i firstLane =
         _mm256_permutevar8x32_epi32(index0, _mm256_set1_epi32(__builtin_ctz(interior)));
     alignas(32) std::int32_t index[8];
@@ -149,7 +151,8 @@ template <typename T>
 
 // The batch's samples at positions u, colours c, lit as kernel::shade()
 // lights each: those with opacity > 0; the others are left as they are.
-template <typename T>
+// kPower: how nh^shininess is raised (specular_power.h).
+template <typename T, int kPower = kTablePower>
 [[gnu::always_inline]] inline void shadeQuads(const T* v, const KernelParams& p, const RaySetup& ray,
                                               const __m256 u[3], Quads& c) {
   const __m256 visible = _mm256_cmp_ps(alphaLanes(c), _mm256_setzero_ps(), _CMP_GT_OQ);
@@ -170,17 +173,23 @@ template <typename T>
   const __m256 nl = dot(ray.light), nh = dot(ray.halfway);
   const __m256 ambient = _mm256_set1_ps(p.ambient), diffuse = _mm256_set1_ps(p.diffuse);
   const __m256 lit = _mm256_blendv_ps(_mm256_add_ps(ambient, diffuse), _mm256_fmadd_ps(diffuse, nl, ambient), lighted);
-  // nh^shininess from the table (kernel::shade()); lanes not lighted look
-  // up entry 0 and add nothing.
-  const __m256 x = _mm256_and_ps(
-      _mm256_mul_ps(_mm256_min_ps(nh, _mm256_set1_ps(1.0f)), _mm256_set1_ps(float(kSpecularTableSize - 1))), lighted);
-  const __m256i entry = _mm256_min_epi32(_mm256_cvttps_epi32(x), _mm256_set1_epi32(kSpecularTableSize - 2));
-  alignas(32) std::int32_t e[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(e), entry);
-  __m256 t0, t1;
-  loadPairs8(p.specularTable, e, 0, t0, t1);
-  const __m256 spec = _mm256_and_ps(
-      _mm256_mul_ps(_mm256_set1_ps(p.specular), lerp8(t0, t1, _mm256_sub_ps(x, _mm256_cvtepi32_ps(entry)))), lighted);
+  // nh^shininess as kernel::shade() raises it: by steps (specular_power.h)
+  // or from the table, where lanes not lighted look up entry 0. Those add
+  // nothing.
+  __m256 power;
+  if constexpr (kPower == kTablePower) {
+    const __m256 x = _mm256_and_ps(
+        _mm256_mul_ps(_mm256_min_ps(nh, _mm256_set1_ps(1.0f)), _mm256_set1_ps(float(kSpecularTableSize - 1))), lighted);
+    const __m256i entry = _mm256_min_epi32(_mm256_cvttps_epi32(x), _mm256_set1_epi32(kSpecularTableSize - 2));
+    alignas(32) std::int32_t e[8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(e), entry);
+    __m256 t0, t1;
+    loadPairs8(p.specularTable, e, 0, t0, t1);
+    power = lerp8(t0, t1, _mm256_sub_ps(x, _mm256_cvtepi32_ps(entry)));
+  } else {
+    power = powerBySteps8<kPower>(_mm256_min_ps(nh, _mm256_set1_ps(1.0f)), p.powerFloor);
+  }
+  const __m256 spec = _mm256_and_ps(_mm256_mul_ps(_mm256_set1_ps(p.specular), power), lighted);
   // Invisible lanes keep their colour: times 1, plus 0.
   const __m256 scale = _mm256_blendv_ps(_mm256_set1_ps(1.0f), lit, visible);
   const __m256 add = _mm256_and_ps(spec, visible);

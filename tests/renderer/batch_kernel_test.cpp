@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <limits>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "raycast/cast_ray.h"
@@ -49,22 +51,23 @@ struct Run {
   bool terminated = false;
 };
 
-// Samples [first, last) one at a time.
-template <typename V, bool kShaded>
+// Samples [first, last) one at a time (kPower: specular_power.h).
+template <typename V, bool kShaded, int kPower = kernel::kTablePower>
 Run scalarRun(const KernelParams& p, const RaySetup& ray, std::int64_t first, std::int64_t last) {
   Run r;
-  r.terminated = kernel::runScalar<V, kShaded, false>(p, ray, first, last, r.acc, r.samples);
+  r.terminated = kernel::runScalar<V, kShaded, false, kPower>(p, ray, first, last, r.acc, r.samples);
   return r;
 }
 
 // Samples [first, last) batched, the rest one at a time.
-template <typename V, bool kShaded>
+template <typename V, bool kShaded, int kPower = kernel::kTablePower>
 Run batchedRun(const KernelParams& p, const RaySetup& ray, std::int64_t first, std::int64_t last) {
   Run r;
   std::int64_t start = first;
-  r.terminated = kernel::runBatched<V, kShaded>(p, ray, start, last, r.acc, r.samples);
+  r.terminated = kernel::runBatched<V, kShaded, kPower>(p, ray, start, last, r.acc, r.samples);
   r.stoppedAt = start;
-  if (!r.terminated) r.terminated = kernel::runScalar<V, kShaded, false>(p, ray, start, last, r.acc, r.samples);
+  if (!r.terminated)
+    r.terminated = kernel::runScalar<V, kShaded, false, kPower>(p, ray, start, last, r.acc, r.samples);
   return r;
 }
 
@@ -80,7 +83,8 @@ double difference(const kernel::Accumulator& a, const kernel::Accumulator& b) {
 // at most over rays of ~100 samples through a dense, sharply classified
 // volume, with transparent stretches (clear ends of the transfer function)
 // and, in float32, non-finite voxels that classify as empty. Every ray of a
-// view, shaded and unshaded, uint8 and float32.
+// view, unshaded and shaded (the specular power from the table and by
+// steps, specular_power.h), uint8 and float32.
 TEST_CASE("the batched plain kernel equals the scalar kernel", "[raycast]") {
   const GridGeometry grid = cubeGrid(40);
   auto field = [](Vec3 q) { return 0.5 + 0.45 * std::sin(q.x * 0.31) * std::cos(q.y * 0.23 + q.z * 0.17); };
@@ -108,7 +112,8 @@ TEST_CASE("the batched plain kernel equals the scalar kernel", "[raycast]") {
                                    {0, 0, 1}, 40, 24, 24);
   for (const Brick* volume : {&floats, &bytes}) {
     const bool uint8 = volume->type() == ScalarType::kUInt8;
-    for (bool shaded : {false, true}) {
+    for (int mode : {0, 1, 2}) {  // unshaded; shaded, the power from the table; shaded, by steps
+      const bool shaded = mode > 0;
       const RenderOptions o = makeOptions(0.45, false, shaded);
       Setup s(*volume, uint8 ? tf8 : tf, o);
       REQUIRE(s.p.indices32);
@@ -121,20 +126,20 @@ TEST_CASE("the batched plain kernel equals the scalar kernel", "[raycast]") {
           const RaySetup ray = raySetup(camera.ray(x, y), grid, o.step, normalize(Vec3{0.2, 0.4, -1}));
           std::int64_t first = 0, last = 0;
           if (!kernel::sampleRange(s.p, ray, first, last) || last - first < 20) continue;
-          const Run a = uint8 ? (shaded ? scalarRun<std::uint8_t, true>(s.p, ray, first, last)
-                                        : scalarRun<std::uint8_t, false>(s.p, ray, first, last))
-                              : (shaded ? scalarRun<float, true>(s.p, ray, first, last)
-                                        : scalarRun<float, false>(s.p, ray, first, last));
-          const Run b = uint8 ? (shaded ? batchedRun<std::uint8_t, true>(s.p, ray, first, last)
-                                        : batchedRun<std::uint8_t, false>(s.p, ray, first, last))
-                              : (shaded ? batchedRun<float, true>(s.p, ray, first, last)
-                                        : batchedRun<float, false>(s.p, ray, first, last));
+          auto both = [&](auto tag) {
+            using V = std::remove_pointer_t<decltype(tag)>;
+            if (mode == 0) return std::pair{scalarRun<V, false>(s.p, ray, first, last), batchedRun<V, false>(s.p, ray, first, last)};
+            if (mode == 1) return std::pair{scalarRun<V, true>(s.p, ray, first, last), batchedRun<V, true>(s.p, ray, first, last)};
+            return std::pair{scalarRun<V, true, kernel::kPowerBits>(s.p, ray, first, last),
+                             batchedRun<V, true, kernel::kPowerBits>(s.p, ray, first, last)};
+          };
+          const auto [a, b] = uint8 ? both(static_cast<std::uint8_t*>(nullptr)) : both(static_cast<float*>(nullptr));
           CHECK(a.samples == b.samples);
           CHECK(std::isfinite(b.acc.r + b.acc.g + b.acc.b + b.acc.a));
           worst = std::max(worst, difference(a.acc, b.acc));
           ++rays;
         }
-      INFO((uint8 ? "uint8" : "float32") << (shaded ? " shaded" : " unshaded") << ": " << rays
+      INFO((uint8 ? "uint8" : "float32") << (shaded ? " shaded" : " unshaded") << " mode " << mode << ": " << rays
                                          << " rays, max difference " << worst);
       CHECK(rays > 100);
       CHECK(worst < 1e-5);

@@ -521,6 +521,37 @@ TEST_CASE("shading matches the reference", "[raycast]") {
   }
 }
 
+// Identity: a whole shininess (24: the kernel raises the specular power
+// by steps, specular_power.h) lights as the interpolated table lights a
+// shininess a hair away (24.0001: not whole), whose powers differ by at
+// most 1e-4 |ln x| x^24 < 2e-6 relative; the table's own interpolation
+// errs up to 1.6e-5 relative, so 1e-4 of a strong specular term (ks 1,
+// an oblique light) bounds it. A wrong bit or a missing power differs by
+// far more: shininess 16 against 24 is checked to differ by over 1e-2.
+TEST_CASE("a whole shininess lights as the table lights one a hair away", "[raycast]") {
+  const GridGeometry grid = cubeGrid(32);
+  const Camera camera =
+      perspective(grid.center() - normalize(Vec3{0.7, 0.5, -0.5}) * 60.0, grid.center(), {0, 0, 1}, 35, 48, 48);
+  auto lit = [&, volume = blobVolume(grid), tf = softTransfer(1.0)](double shininess) {
+    RenderOptions o = makeOptions(0.5, false, true);
+    o.shading.lightDirection = Vec3{0.6, 0.5, 0.3};
+    o.shading.specular = 1.0;
+    o.shading.shininess = shininess;
+    return cast(volume, tf, camera, o);
+  };
+  const Image steps = lit(24), table = lit(24.0001), other = lit(16);
+  double worst = 0, apart = 0;
+  for (std::size_t i = 0; i < steps.pixels().size(); ++i) {
+    const Rgba& q = table.pixels()[i];
+    worst = std::max(worst, maxChannelDifference(steps.pixels()[i], RgbaD{q.r, q.g, q.b, q.a}));
+    const Rgba& o = other.pixels()[i];
+    apart = std::max(apart, maxChannelDifference(steps.pixels()[i], RgbaD{o.r, o.g, o.b, o.a}));
+  }
+  INFO("max difference from the table " << worst << ", from shininess 16 " << apart);
+  CHECK(worst < 1e-4);
+  CHECK(apart > 1e-2);
+}
+
 // ---------------------------------------------------------------------------
 // Non-finite data and degenerate transfer functions.
 

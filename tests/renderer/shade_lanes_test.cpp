@@ -33,6 +33,11 @@ KernelFixture setup(const Brick& brick) {
   return KernelFixture(brick, opaqueRamp(), o);
 }
 
+// The two ways a shaded kernel raises the specular power
+// (specular_power.h): from the table, and by steps (shininess 24 is whole).
+using TablePower = std::integral_constant<int, kernel::kTablePower>;
+using StepsPower = std::integral_constant<int, kernel::kPowerBits>;
+
 // A field with detail in every direction; in float32 some voxels NaN or
 // infinite, which the gradients around them carry.
 Brick volumeOf(ScalarType type, const GridGeometry& grid) {
@@ -138,8 +143,11 @@ TEST_CASE("the vector gradient equals the scalar gradient", "[raycast]") {
 // Identity: shadeQuads() lights each sample of opacity > 0 as
 // kernel::shade() does and leaves the others as they are, up to float
 // rounding, NaN and infinite voxels around samples included (a non-finite
-// gradient is lit head-on).
-TEST_CASE("batched lighting equals lighting one sample at a time", "[raycast]") {
+// gradient is lit head-on); the specular power from the table and by
+// steps alike (specular_power.h).
+TEMPLATE_TEST_CASE("batched lighting equals lighting one sample at a time", "[raycast]", TablePower,
+                   StepsPower) {
+  constexpr int kPower = TestType::value;
   const GridGeometry grid = cubeGrid(24);
   std::mt19937 random(11);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
@@ -169,7 +177,7 @@ TEST_CASE("batched lighting equals lighting one sample at a time", "[raycast]") 
                                 colour[j + 4].g, colour[j + 4].b, colour[j + 4].a);
       dispatchScalar(type, [&](auto tag) {
         using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
-        kernel::shadeQuads(static_cast<const T*>(s.p.voxels), s.p, ray, lanes, c);
+        kernel::shadeQuads<T, kPower>(static_cast<const T*>(s.p.voxels), s.p, ray, lanes, c);
       });
       alignas(32) float out[4][8];
       for (int j = 0; j < 4; ++j) _mm256_store_ps(out[j], c.q[j]);
@@ -178,7 +186,8 @@ TEST_CASE("batched lighting equals lighting one sample at a time", "[raycast]") 
         if (expected.a > 0)
           dispatchScalar(type, [&](auto tag) {
             using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
-            expected = kernel::shade(static_cast<const T*>(s.p.voxels), s.p, ray, u[0][j], u[1][j], u[2][j], expected);
+            expected =
+                kernel::shade<T, kPower>(static_cast<const T*>(s.p.voxels), s.p, ray, u[0][j], u[1][j], u[2][j], expected);
           });
         const float* got = &out[j % 4][4 * (j / 4)];
         const float want[4] = {expected.r, expected.g, expected.b, expected.a};
@@ -188,9 +197,54 @@ TEST_CASE("batched lighting equals lighting one sample at a time", "[raycast]") 
         }
       }
     }
-    INFO("type " << int(type) << ": max difference " << worst);
+    INFO("type " << int(type) << ", power " << kPower << ": max difference " << worst);
     CHECK(worst < 1e-5);
   }
+}
+
+// The specular power by steps (specular_power.h): the step count of each
+// shininess (whole ones up to 255; the table for the others); x^n within
+// the stated bound of 2 n 2^-24 relative of the exact power for every
+// whole n and x in [0, 1] (near 1 and near 0 included); the vector form
+// equal to the scalar one bit for bit; and more steps than n's bits give
+// the same bits (the kernel takes kPowerBits for every n).
+TEST_CASE("the specular power by steps is x to the shininess", "[raycast]") {
+  CHECK(kernel::powerBits(1.0) == 1);
+  CHECK(kernel::powerBits(24.0) == 5);
+  CHECK(kernel::powerBits(32.0) == 6);
+  CHECK(kernel::powerBits(255.0) == 8);
+  CHECK(kernel::powerBits(24.5) == kernel::kTablePower);
+  CHECK(kernel::powerBits(0.5) == kernel::kTablePower);
+  CHECK(kernel::powerBits(256.0) == kernel::kTablePower);
+  CHECK(kernel::powerBits(std::numeric_limits<double>::quiet_NaN()) == kernel::kTablePower);
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  double worst = 0;  // relative error, in units of the bound
+  for (int n = 1; n < (1 << kernel::kPowerBits); ++n) {
+    float floor[kernel::kPowerBits];
+    kernel::setPowerFloor(n, floor);
+    for (int k = 0; k < 64; ++k) {
+      alignas(32) float x[8], got8[8];
+      for (int j = 0; j < 8; ++j)
+        x[j] = k == 0 ? float(j) / 7.0f : j == 0 ? 1.0f - unit(random) * 1e-3f : j == 1 ? unit(random) * 1e-2f : unit(random);
+      _mm256_store_ps(got8, kernel::powerBySteps8<kernel::kPowerBits>(_mm256_load_ps(x), floor));
+      for (int j = 0; j < 8; ++j) {
+        const float got = kernel::powerBySteps<kernel::kPowerBits>(x[j], floor);
+        INFO("x " << x[j] << " n " << n);
+        REQUIRE(got == got8[j]);
+        if (n < 16) REQUIRE(got == kernel::powerBySteps<4>(x[j], floor));
+        const double exact = std::pow(double(x[j]), double(n));
+        if (exact < 1e-30) {
+          CHECK(got < 1e-29f);  // underflows towards 0
+          continue;
+        }
+        worst = std::max(worst, std::abs(got - exact) / exact / (2 * n * std::ldexp(1.0, -24)));
+      }
+    }
+  }
+  INFO("worst relative error, in units of 2 n 2^-24: " << worst);
+  CHECK(worst <= 1.0);
+  CHECK(worst > 0.01);  // it was measured, not rounded away
 }
 
 }  // namespace pvr::core
