@@ -283,7 +283,7 @@ template <bool kCentre>
     const __m512d variance = _mm512_mask_blend_pd(
         _mm512_cmp_pd_mask(depth, _mm512_set1_pd(1e-2), _CMP_LT_OQ),
         _mm512_fmsub_pd(inverseDepth, inverseDepth, _mm512_mul_pd(transmitted, inverseAlpha)),
-        _mm512_fnmadd_pd(_mm512_mul_pd(depth, depth), _mm512_set1_pd(1.0 / 720), _mm512_set1_pd(1.0 / 12)));
+        _mm512_fnmadd_pd(_mm512_mul_pd(depth, depth), _mm512_set1_pd(1.0 / 240), _mm512_set1_pd(1.0 / 12)));
     s.spread = _mm512_maskz_sqrt_pd(kAll, _mm512_maskz_max_pd(kAll, variance, zero));
   }
   return s;
