@@ -31,9 +31,8 @@ using RayFunction = void (*)(const KernelParams&, const RaySetup*, int, int, con
 template <typename T>
 RayFunction pickKernel(bool shaded, bool preintegrated, int powerBits) {
   if (!shaded) return preintegrated ? &castRays<T, false, true> : &castRays<T, false, false>;
-  if (preintegrated || powerBits == kernel::kTablePower) {
-    return preintegrated ? &castRays<T, true, true> : &castRays<T, true, false>;
-  }
+  if (preintegrated) return &castRays<T, true, true>;
+  if (powerBits == kernel::kTablePower) return &castRays<T, true, false>;
   if (powerBits <= 5) return &castRays<T, true, false, 5>;
   return powerBits <= 6 ? &castRays<T, true, false, 6> : &castRays<T, true, false, kernel::kPowerBits>;
 }
