@@ -163,15 +163,19 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
 }
 
 // Where the ray goes on from sample k: k itself when k's macrocell is
-// visible; else past the empty cube around it that the distance field
-// proves (emptyExit). o and d: the ray's origin and step in float, as the
-// samples'.
-[[gnu::always_inline]] inline std::int64_t pastEmpty(const KernelParams& p, const CubeExit& cube, const float* o,
-                                                     const float* d, std::int64_t k, int mcShift) {
+// visible; else past the empty box ahead of it that `field` proves
+// (emptyExit): p.leapField[octantOf(ray)], whose box reaches forward from
+// the macrocell in the ray's direction (or the cube around it). o and d:
+// the ray's origin and step in float, as the samples'. Each axis's float
+// position is monotonic in k, so the samples after k never fall behind
+// k's macrocell, where a forward box proves nothing.
+[[gnu::always_inline]] inline std::int64_t pastEmpty(const KernelParams& p, const std::uint8_t* field,
+                                                     const CubeExit& cube, const float* o, const float* d,
+                                                     std::int64_t k, int mcShift) {
   int m[3];
   for (int a = 0; a < 3; ++a)
     m[a] = std::clamp(int(o[a] + float(k) * d[a]) >> mcShift, p.mcFirst[a], p.mcFirst[a] + p.mcCount[a] - 1);
-  const int distance = p.distance[macrocellIndex(p, m)];
+  const int distance = field[macrocellIndex(p, m)];
   if (distance == 0) return k;
   return cube.exit(m, distance, k);
 }
@@ -222,13 +226,14 @@ class RayWalk {
     done_ = first_;
     chunk_ = visibleChunk(ray);
     cube_ = CubeExit(ray, mcShift);
+    field_ = p.leapField[octantOf(ray)];
     return true;
   }
 
   // One look-up, and a chunk of samples where it finds something visible.
   // False when the ray is done (out holds its result).
   bool step(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
-    if (const std::int64_t next = pastEmpty(p, cube_, o_, d_, k_, mcShift); next != k_) {
+    if (const std::int64_t next = pastEmpty(p, field_, cube_, o_, d_, k_, mcShift); next != k_) {
       k_ = next;
       return k_ <= end_ || finish(out);
     }
@@ -259,6 +264,7 @@ class RayWalk {
   std::int64_t chunk_ = 0;
   ChordEnds ends_;
   CubeExit cube_;
+  const std::uint8_t* field_ = nullptr;  // the distance field this ray leaps by (pastEmpty)
   float o_[3], d_[3];  // the ray's origin and step in float, as the samples'
   Accumulator acc_;
 };

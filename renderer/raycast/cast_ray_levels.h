@@ -104,11 +104,12 @@ RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShif
   const float o[3] = {float(ray.origin[0]), float(ray.origin[1]), float(ray.origin[2])};
   const float d[3] = {float(ray.step[0]), float(ray.step[1]), float(ray.step[2])};
   const kernel::CubeExit cube(ray, mcShift);
+  const std::uint8_t* field = p.leapField[kernel::octantOf(ray)];
   kernel::Accumulator acc;
   while (k <= end) {  // k: the next fine sample not yet covered or skipped
     // Empty space is skipped as castRay skips it: a coarse sample in
     // skipped space is transparent too.
-    if (const std::int64_t next = kernel::pastEmpty(p, cube, o, d, k, mcShift); next != k) {
+    if (const std::int64_t next = kernel::pastEmpty(p, field, cube, o, d, k, mcShift); next != k) {
       k = next;
       continue;
     }

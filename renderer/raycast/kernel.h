@@ -39,6 +39,9 @@ struct KernelParams {
   float invSpacing[3];  // 1 / spacing, for world-space gradients
   // Macrocells.
   const std::uint8_t* distance = nullptr;  // MacrocellGrid::distance(): 0 = visible
+  // The field a ray leaps by, by its direction octant (octantOf):
+  // MacrocellGrid::leapFields(), or distance for every octant.
+  const std::uint8_t* leapField[8] = {};
   int mcFirst[3], mcCount[3];
   // Every sample whose macrocell is visible lies in this box, index units
   // (the visible macrocells' box, MacrocellGrid::visibleFirst(), widened
@@ -469,6 +472,12 @@ inline Rgba stretch(const Rgba& c, double w) {
 inline std::size_t macrocellIndex(const KernelParams& p, const int* m) {
   return std::size_t(((m[2] - p.mcFirst[2]) * p.mcCount[1] + (m[1] - p.mcFirst[1])) * p.mcCount[0] +
                      (m[0] - p.mcFirst[0]));
+}
+
+// The ray's direction octant: bit a set when it goes down axis a (a ray
+// that does not move along an axis counts as going up it).
+inline int octantOf(const RaySetup& r) {
+  return int(r.step[0] < 0) | int(r.step[1] < 0) << 1 | int(r.step[2] < 0) << 2;
 }
 
 // Samples taken per look-up while a ray is in visible macrocells: about

@@ -42,6 +42,34 @@ void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocel
     }
   }
   p.distance = macrocells.distance();
+  for (auto& field : p.leapField) field = p.distance;
+}
+
+unsigned frameOctants(const Camera& camera, const PixelRect& rect) {
+  if (rect.empty()) return 0;
+  // A camera ray's direction is a linear function of the pixel's
+  // position, normalised: over a rectangle of pixels each component takes
+  // its extremes, and so both of its signs if it has them, at the corners.
+  unsigned down[3] = {0, 0, 0}, up[3] = {0, 0, 0};
+  for (int x : {rect.x0, rect.x1 - 1})
+    for (int y : {rect.y0, rect.y1 - 1}) {
+      const Vec3 d = camera.ray(x, y).direction;
+      for (int a = 0; a < 3; ++a) {
+        down[a] |= d[a] < 0;
+        up[a] |= !(d[a] < 0);
+      }
+    }
+  unsigned mask = 0;
+  for (int o = 0; o < 8; ++o) {
+    bool used = true;
+    for (int a = 0; a < 3; ++a) used = used && ((o >> a & 1) ? down[a] : up[a]);
+    mask |= unsigned(used) << o;
+  }
+  return mask;
+}
+
+void setLeapFields(KernelParams& p, const MacrocellGrid::LeapFields& fields) {
+  for (int o = 0; o < 8; ++o) p.leapField[o] = fields.byOctant[o];
 }
 
 void ownRegion(KernelParams& p, const GridGeometry& grid, const WorldRegion& region) {

@@ -20,6 +20,14 @@ namespace pvr::core {
 // macrocells of `brick`; the classification table is the caller's.
 void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocells);
 
+// The direction octants (kernel::octantOf) of the camera's rays through
+// the pixels of `rect`, as a mask: bit o set when some ray is in octant o.
+unsigned frameOctants(const Camera& camera, const PixelRect& rect);
+
+// The fields rays leap by, per octant (MacrocellGrid::leapFields); `fields`
+// must outlive p. Without it every octant leaps by distance() (setBrick).
+void setLeapFields(KernelParams& p, const MacrocellGrid::LeapFields& fields);
+
 // Ownership by a region instead of the owned box: the region's faces in
 // index units, clipped to the domain [0, dims - 1], the far face closed
 // where the region reaches beyond the domain (raycaster.h, restrictTo).

@@ -47,4 +47,14 @@ constexpr bool leapDistanceFits(int leap, int exact) {
 // nothing visible within reach of the bound).
 void leapDistance(std::uint8_t* distance, IVec3 count, ThreadPool* pool = nullptr);
 
+// The same for rays of one direction octant (bit a of `octant` set: the
+// ray goes down axis a), per Deakin & Knackstedt 2020: the distance D
+// such that the box of macrocells m + t * sign, 0 <= t_a < D, reaching
+// only forward from m, is empty. A cube around m is cut short by whatever
+// lies behind or beside the ray; this box is not, and the leap
+// (kernel::CubeExit) only ever crosses the forward faces of either. Exact
+// below kLeapNear; beyond, the cube's coarse bound (at least kLeapNear,
+// never more than the truth: the box lies in the cube). Same input.
+void forwardLeapDistance(std::uint8_t* distance, IVec3 count, int octant, ThreadPool* pool = nullptr);
+
 }  // namespace pvr::core

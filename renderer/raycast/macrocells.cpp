@@ -127,6 +127,11 @@ MacrocellGrid::MacrocellGrid(const Brick& brick, ThreadPool* pool) : bounds_(bri
 }
 
 void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty, ThreadPool* pool) {
+  {
+    std::lock_guard<std::mutex> lock(forward_->mutex);
+    for (auto& field : forward_->byOctant) field.reset();
+  }
+  skipEmpty_ = skipEmpty;
   if (!skipEmpty) {
     std::fill(distance_.begin(), distance_.end(), std::uint8_t(0));  // every macrocell sampled
     findVisibleBox();
@@ -171,6 +176,39 @@ void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty, ThreadP
   });
   leapDistance(distance_.data(), count(), pool);
   findVisibleBox();
+}
+
+MacrocellGrid::LeapFields MacrocellGrid::leapFields(unsigned wanted, ThreadPool* pool) const {
+  LeapFields out;
+  std::lock_guard<std::mutex> lock(forward_->mutex);
+  auto& cache = forward_->byOctant;
+  int kept = 0, missing = 0;
+  for (int o = 0; o < 8; ++o) {
+    kept += bool(cache[o]);
+    missing += !cache[o] && (wanted >> o & 1);
+  }
+  // Fields this frame does not want make room for those it does.
+  for (int o = 0; o < 8 && kept + missing > kForwardFieldsKept; ++o)
+    if (cache[o] && !(wanted >> o & 1)) {
+      cache[o].reset();
+      --kept;
+    }
+  for (int o = 0; o < 8; ++o) {
+    out.byOctant[o] = distance_.data();
+    if (!skipEmpty_ || !(wanted >> o & 1)) continue;
+    if (!cache[o] && kept < kForwardFieldsKept) {
+      // distance_ marks the visible macrocells 0 and no other.
+      auto field = std::make_shared<std::vector<std::uint8_t>>(distance_);
+      forwardLeapDistance(field->data(), count(), o, pool);
+      cache[o] = std::move(field);
+      ++kept;
+    }
+    if (cache[o]) {
+      out.held[o] = cache[o];
+      out.byOctant[o] = cache[o]->data();
+    }
+  }
+  return out;
 }
 
 void MacrocellGrid::findVisibleBox() {

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "../brick.h"
@@ -56,6 +57,19 @@ class MacrocellGrid {
   // Seconds the constructor spent computing bounds (0 when the brick had them).
   double buildSeconds() const { return buildSeconds_; }
 
+  // The fields rays leap by, one per direction octant (bit a set: the ray
+  // goes down axis a; octantOf in kernel.h): for the octants in the mask
+  // `wanted`, forwardLeapDistance's field (leap_distance.h), built over the
+  // pool on first use after classify() and kept; for the others, and for
+  // those beyond kForwardFieldsKept, distance(), which is as safe and leaps
+  // less far. Holds what it hands out alive until the result goes.
+  static constexpr int kForwardFieldsKept = 4;  // a byte per macrocell each
+  struct LeapFields {
+    const std::uint8_t* byOctant[8];
+    std::shared_ptr<const std::vector<std::uint8_t>> held[8];
+  };
+  LeapFields leapFields(unsigned wanted, ThreadPool* pool = nullptr) const;
+
  private:
   void findVisibleBox();  // visibleFirst_ and visibleLast_ from distance_
 
@@ -63,6 +77,13 @@ class MacrocellGrid {
   std::vector<std::uint8_t> distance_;
   IVec3 visibleFirst_, visibleLast_;
   double buildSeconds_ = 0;
+  bool skipEmpty_ = false;  // as last classified: when off, distance() is all 0 and serves every octant
+  // The forward fields built since classify(), by octant (leapFields).
+  struct ForwardCache {
+    std::mutex mutex;
+    std::shared_ptr<const std::vector<std::uint8_t>> byOctant[8];
+  };
+  std::unique_ptr<ForwardCache> forward_ = std::make_unique<ForwardCache>();
 };
 
 // The exact chessboard distance transform of `distance` (count.x fastest),

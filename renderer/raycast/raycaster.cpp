@@ -141,6 +141,9 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
   // Set up what does not change per ray.
   KernelParams p;
   setBrick(p, brick_, macrocells_);
+  // Each ray leaps by the empty box ahead of it in its direction octant.
+  const MacrocellGrid::LeapFields leapFields = macrocells_.leapFields(frameOctants(camera, image.rect()), &pool);
+  setLeapFields(p, leapFields);
   if (region_) ownRegion(p, grid, *region_);
   const bool levelled = !levelTables_.empty();
   // The rays' sample spacing.

@@ -8,8 +8,10 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -17,6 +19,7 @@
 #include "raycast/cast_ray_levels.h"
 #include "raycast/kernel.h"
 #include "raycast/kernel_setup.h"
+#include "raycast/leap_distance.h"
 #include "raycast/macrocells.h"
 #include "raycast/raycaster.h"
 #include "raycast/step_levels.h"
@@ -236,6 +239,127 @@ TEST_CASE("a ray crosses the empty cube around its macrocell in one leap", "[ray
         CHECK(u >= double((m[a] - distance + 1) * kSize) - 1e-9);
         CHECK(u <= double((m[a] + distance) * kSize) + 1e-9);
       }
+  }
+}
+
+// pastEmpty by a direction octant's forward field (leap_distance.h,
+// forwardLeapDistance): over random visibility grids and random rays from
+// anywhere in the grid, every sample a leap passes lies in an empty
+// macrocell, judged by the sample's own float position as the kernel
+// computes it. A field one macrocell too long anywhere, or one reaching
+// backwards, lets some leap pass a visible macrocell here. The forward
+// leaps also take fewer look-ups than the cube's over the same rays.
+TEST_CASE("a ray leaps by its octant's forward field only across empty macrocells", "[raycast]") {
+  constexpr int kShift = MacrocellGrid::kShift, kSize = MacrocellGrid::kSize;
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const IVec3 n{19, 23, 17};
+  std::int64_t forwardLookUps = 0, cubeLookUps = 0, passed = 0;
+  for (double density : {0.002, 0.01, 0.04, 0.15}) {
+    std::vector<std::uint8_t> visible(std::size_t(n.product()));
+    std::bernoulli_distribution coin(density);
+    for (auto& v : visible) v = coin(rng) ? 0 : 255;
+    std::vector<std::uint8_t> cube = visible;
+    leapDistance(cube.data(), n);
+    std::vector<std::vector<std::uint8_t>> forward(8, visible);
+    for (int o = 0; o < 8; ++o) forwardLeapDistance(forward[std::size_t(o)].data(), n, o);
+    KernelParams p;
+    for (int a = 0; a < 3; ++a) {
+      p.mcFirst[a] = 0;
+      p.mcCount[a] = n[a];
+    }
+    for (int trial = 0; trial < 3000; ++trial) {
+      Vec3 dir{uniform(rng) - 0.5, uniform(rng) - 0.5, uniform(rng) - 0.5};
+      if (trial % 11 == 0) dir[trial % 3] = 0;  // in a plane of the grid
+      if (trial % 13 == 0) dir = Vec3{0, 0, 0}, dir[trial % 3] = trial % 2 ? 1.0 : -1.0;
+      dir = normalize(dir);
+      RaySetup r{};
+      const double step = 0.2 + 1.5 * uniform(rng);
+      for (int a = 0; a < 3; ++a) {
+        r.origin[a] = uniform(rng) * n[a] * kSize;
+        r.step[a] = dir[a] * step;
+        r.invStep[a] = r.step[a] != 0 ? 1 / r.step[a] : 0;
+      }
+      const int octant = kernel::octantOf(r);
+      const float o[3] = {float(r.origin[0]), float(r.origin[1]), float(r.origin[2])};
+      const float d[3] = {float(r.step[0]), float(r.step[1]), float(r.step[2])};
+      const kernel::CubeExit exit(r, kShift);
+      // The samples' macrocells while the ray is in the grid.
+      auto macrocell = [&](std::int64_t s, int* m) {
+        bool in = true;
+        for (int a = 0; a < 3; ++a) {
+          const float u = o[a] + float(s) * d[a];
+          in = in && u >= 0 && u < float(n[a] * kSize);
+          m[a] = int(u) >> kShift;
+        }
+        return in;
+      };
+      auto walk = [&](const std::uint8_t* field, bool check) {
+        std::int64_t lookUps = 0;
+        int m[3];
+        for (std::int64_t k = 0; macrocell(k, m);) {
+          const std::int64_t next = kernel::pastEmpty(p, field, exit, o, d, k, kShift);
+          ++lookUps;
+          if (next == k) {
+            ++k;
+            continue;
+          }
+          for (std::int64_t s = k; check && s < next && macrocell(s, m); ++s) {
+            ++passed;
+            if (visible[std::size_t((m[2] * n.y + m[1]) * n.x + m[0])] == 0)
+              FAIL("trial " << trial << " octant " << octant << ": the leap from sample " << k << " to " << next
+                            << " passes sample " << s << " in visible macrocell " << m[0] << " " << m[1] << " "
+                            << m[2]);
+          }
+          k = next;
+        }
+        return lookUps;
+      };
+      forwardLookUps += walk(forward[std::size_t(octant)].data(), true);
+      cubeLookUps += walk(cube.data(), false);
+    }
+  }
+  INFO("look-ups: forward " << forwardLookUps << ", cube " << cubeLookUps << "; samples passed " << passed);
+  CHECK(passed > 100000);
+  CHECK(forwardLookUps < cubeLookUps);
+}
+
+// frameOctants holds the octant of every camera ray through the
+// rectangle, and leapFields gives those octants their forward fields, at
+// most kForwardFieldsKept of them, and the cube's field to the others.
+TEST_CASE("a frame leaps by the forward fields of its rays' octants", "[raycast]") {
+  const Brick volume = speckVolume();
+  BrickRenderer renderer(volume);
+  renderer.classify(blobAndSpeck(), makeOptions(0.5, false));
+  const MacrocellGrid& grid = renderer.macrocells();
+  const std::vector<Camera> cameras = {
+      makeCamera(Projection::kPerspective, {80, -40, 75}, {20, 20, 20}, {0, 0, 1}, 20, 32, 32),    // one octant
+      makeCamera(Projection::kPerspective, {20, 20, -80}, {20, 20, 20}, {0, 1, 0}, 40, 32, 32),    // four
+      makeCamera(Projection::kPerspective, {20, 19, 21}, {30, 25, 25}, {0, 0, 1}, 120, 32, 32),    // inside
+      makeCamera(Projection::kOrthographic, {20, -60, 20}, {20, 20, 20}, {0, 0, 1}, 40, 32, 32)};  // one
+  const int want[] = {1, 4, 8, 1};
+  for (std::size_t c = 0; c < cameras.size(); ++c) {
+    CAPTURE(c);
+    const PixelRect rect{0, 0, 32, 32};
+    const unsigned mask = frameOctants(cameras[c], rect);
+    CHECK(std::popcount(mask) == want[c]);
+    for (int y = 0; y < 32; ++y)
+      for (int x = 0; x < 32; ++x) {
+        const RaySetup r = raySetup(cameras[c].ray(x, y), volume.grid(), 0.5, Vec3{0, 0, 1});
+        CHECK((mask >> kernel::octantOf(r) & 1));
+      }
+    const MacrocellGrid::LeapFields fields = grid.leapFields(mask, &pool());
+    int forward = 0;
+    for (int o = 0; o < 8; ++o) {
+      const bool own = fields.byOctant[o] != grid.distance();
+      forward += own;
+      if (!(mask >> o & 1)) CHECK_FALSE(own);
+      if (!own) continue;
+      std::vector<std::uint8_t> exact(grid.distance(), grid.distance() + grid.count().product());
+      forwardLeapDistance(exact.data(), grid.count(), o);
+      CHECK(std::equal(exact.begin(), exact.end(), fields.byOctant[o]));
+    }
+    CHECK(forward == std::min(want[c], MacrocellGrid::kForwardFieldsKept));
   }
 }
 

@@ -325,6 +325,69 @@ TEST_CASE("the leap distance is exact near what is visible and a close lower bou
     }
 }
 
+// The forward distance by its definition: the least over visible q in the
+// octant ahead of m (q_a - m_a of the octant's sign on every axis, or 0)
+// of the largest |q_a - m_a|, capped at 255.
+static std::vector<std::uint8_t> bruteForwardDistance(const std::vector<std::uint8_t>& visible, IVec3 n, int octant) {
+  std::vector<IVec3> shown;
+  for (std::int64_t z = 0; z < n.z; ++z)
+    for (std::int64_t y = 0; y < n.y; ++y)
+      for (std::int64_t x = 0; x < n.x; ++x)
+        if (visible[std::size_t((z * n.y + y) * n.x + x)]) shown.push_back({x, y, z});
+  std::vector<std::uint8_t> out(visible.size(), 255);
+  for (std::int64_t z = 0; z < n.z; ++z)
+    for (std::int64_t y = 0; y < n.y; ++y)
+      for (std::int64_t x = 0; x < n.x; ++x) {
+        const IVec3 m{x, y, z};
+        std::int64_t best = 255;
+        for (const IVec3& q : shown) {
+          std::int64_t far = 0;
+          bool ahead = true;
+          for (int a = 0; a < 3; ++a) {
+            const std::int64_t t = (octant >> a & 1) ? m[a] - q[a] : q[a] - m[a];
+            ahead = ahead && t >= 0;
+            far = std::max(far, t);
+          }
+          if (ahead) best = std::min(best, far);
+        }
+        out[std::size_t((z * n.y + y) * n.x + x)] = std::uint8_t(best);
+      }
+  return out;
+}
+
+// forwardLeapDistance (leap_distance.h) for each of the eight octants: zero
+// exactly where visible, the exact forward distance below kLeapNear (a
+// window one macrocell too long, or reaching backwards, fails here), and
+// beyond it at least kLeapNear and never more than the truth.
+TEST_CASE("the forward leap distance of each octant is exact near what is visible ahead", "[preprocess]") {
+  ThreadPool pool(2);
+  std::mt19937 rng(23);
+  const IVec3 shapes[] = {{23, 17, 29}, {1, 1, 60}, {60, 2, 1}, {40, 33, 1}};
+  for (const IVec3 n : shapes)
+    for (double density : {0.0, 0.0005, 0.005, 0.05, 0.4, 1.0}) {
+      std::vector<std::uint8_t> visible(std::size_t(n.product()));
+      std::bernoulli_distribution coin(density);
+      for (auto& v : visible) v = coin(rng);
+      if (density == 0.0005) visible[visible.size() / 2] = 1;  // one speck in the middle
+      for (int octant = 0; octant < 8; ++octant) {
+        CAPTURE(n.x, n.y, n.z, density, octant);
+        const auto exact = bruteForwardDistance(visible, n, octant);
+        for (ThreadPool* p : {static_cast<ThreadPool*>(nullptr), &pool}) {
+          std::vector<std::uint8_t> d(visible.size());
+          for (std::size_t i = 0; i < d.size(); ++i) d[i] = visible[i] ? 0 : 255;
+          forwardLeapDistance(d.data(), n, octant, p);
+          std::size_t wrong = 0;
+          for (std::size_t i = 0; i < exact.size(); ++i) {
+            const int want = exact[i], got = d[i];
+            const bool fits = want < kLeapNear ? got == want : got >= kLeapNear && got <= want;
+            if (!fits && wrong++ < 5) FAIL_CHECK("macrocell " << i << ": forward distance " << got << ", exact " << want);
+          }
+          CHECK(wrong == 0);
+        }
+      }
+    }
+}
+
 TEST_CASE("the distance field caps at 255 along a long empty line", "[preprocess]") {
   // One visible macrocell at x = 0 of 300: distances 0, 1, ..., 254, 255, 255, ...
   const IVec3 n{300, 2, 3};
