@@ -476,9 +476,11 @@ inline std::size_t macrocellIndex(const KernelParams& p, const int* m) {
 
 // The ray's direction octant: bit a set when it goes down axis a (a ray
 // that does not move along an axis counts as going up it).
-inline int octantOf(const RaySetup& r) {
-  return int(r.step[0] < 0) | int(r.step[1] < 0) << 1 | int(r.step[2] < 0) << 2;
+template <typename Direction>
+inline int directionOctant(const Direction& d) {
+  return int(d[0] < 0) | int(d[1] < 0) << 1 | int(d[2] < 0) << 2;
 }
+inline int octantOf(const RaySetup& r) { return directionOctant(r.step); }
 
 // Samples taken per look-up while a ray is in visible macrocells: about
 // two macrocells, in whole batches of eight. A look-up is a chain of

@@ -45,27 +45,26 @@ void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocel
   for (auto& field : p.leapField) field = p.distance;
 }
 
-unsigned frameOctants(const Camera& camera, const PixelRect& rect) {
-  if (rect.empty()) return 0;
+std::vector<int> frameOctants(const Camera& camera, const PixelRect& rect) {
+  if (rect.empty()) return {};
   // A camera ray's direction is a linear function of the pixel's
   // position, normalised: over a rectangle of pixels each component takes
   // its extremes, and so both of its signs if it has them, at the corners.
-  unsigned down[3] = {0, 0, 0}, up[3] = {0, 0, 0};
-  for (int x : {rect.x0, rect.x1 - 1})
-    for (int y : {rect.y0, rect.y1 - 1}) {
-      const Vec3 d = camera.ray(x, y).direction;
-      for (int a = 0; a < 3; ++a) {
-        down[a] |= d[a] < 0;
-        up[a] |= !(d[a] < 0);
-      }
+  // An 8 x 8 grid of rays through the rectangle, corners included, finds
+  // every octant and roughly each one's share of the rays.
+  constexpr int kAcross = 8;
+  int rays[8] = {};
+  for (int j = 0; j < kAcross; ++j)
+    for (int i = 0; i < kAcross; ++i) {
+      const int x = rect.x0 + int(std::int64_t(rect.width() - 1) * i / (kAcross - 1));
+      const int y = rect.y0 + int(std::int64_t(rect.height() - 1) * j / (kAcross - 1));
+      ++rays[kernel::directionOctant(camera.ray(x, y).direction)];
     }
-  unsigned mask = 0;
-  for (int o = 0; o < 8; ++o) {
-    bool used = true;
-    for (int a = 0; a < 3; ++a) used = used && ((o >> a & 1) ? down[a] : up[a]);
-    mask |= unsigned(used) << o;
-  }
-  return mask;
+  std::vector<int> octants;
+  for (int o = 0; o < 8; ++o)
+    if (rays[o] > 0) octants.push_back(o);
+  std::stable_sort(octants.begin(), octants.end(), [&](int a, int b) { return rays[a] > rays[b]; });
+  return octants;
 }
 
 void setLeapFields(KernelParams& p, const MacrocellGrid::LeapFields& fields) {

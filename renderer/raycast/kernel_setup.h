@@ -21,8 +21,8 @@ namespace pvr::core {
 void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocells);
 
 // The direction octants (kernel::octantOf) of the camera's rays through
-// the pixels of `rect`, as a mask: bit o set when some ray is in octant o.
-unsigned frameOctants(const Camera& camera, const PixelRect& rect);
+// the pixels of `rect`, those with the most rays first.
+std::vector<int> frameOctants(const Camera& camera, const PixelRect& rect);
 
 // The fields rays leap by, per octant (MacrocellGrid::leapFields); `fields`
 // must outlive p. Without it every octant leaps by distance() (setBrick).

@@ -178,35 +178,28 @@ void MacrocellGrid::classify(const TransferTable& table, bool skipEmpty, ThreadP
   findVisibleBox();
 }
 
-MacrocellGrid::LeapFields MacrocellGrid::leapFields(unsigned wanted, ThreadPool* pool) const {
+int MacrocellGrid::forwardFieldsKept() const { return int(std::clamp<std::size_t>(scalarSize(bounds_->type()), 1, 4)); }
+
+MacrocellGrid::LeapFields MacrocellGrid::leapFields(const std::vector<int>& wanted, ThreadPool* pool) const {
   LeapFields out;
+  bool chosen[8] = {};
+  if (skipEmpty_)  // else distance() is all 0, and so would every forward field be
+    for (std::size_t i = 0; i < std::min(wanted.size(), std::size_t(forwardFieldsKept())); ++i) chosen[wanted[i]] = true;
   std::lock_guard<std::mutex> lock(forward_->mutex);
   auto& cache = forward_->byOctant;
-  int kept = 0, missing = 0;
-  for (int o = 0; o < 8; ++o) {
-    kept += bool(cache[o]);
-    missing += !cache[o] && (wanted >> o & 1);
-  }
-  // Fields this frame does not want make room for those it does.
-  for (int o = 0; o < 8 && kept + missing > kForwardFieldsKept; ++o)
-    if (cache[o] && !(wanted >> o & 1)) {
-      cache[o].reset();
-      --kept;
-    }
+  for (int o = 0; o < 8; ++o)
+    if (!chosen[o]) cache[o].reset();  // within the budget only while wanted
   for (int o = 0; o < 8; ++o) {
     out.byOctant[o] = distance_.data();
-    if (!skipEmpty_ || !(wanted >> o & 1)) continue;
-    if (!cache[o] && kept < kForwardFieldsKept) {
+    if (!chosen[o]) continue;
+    if (!cache[o]) {
       // distance_ marks the visible macrocells 0 and no other.
       auto field = std::make_shared<std::vector<std::uint8_t>>(distance_);
       forwardLeapDistance(field->data(), count(), o, pool);
       cache[o] = std::move(field);
-      ++kept;
     }
-    if (cache[o]) {
-      out.held[o] = cache[o];
-      out.byOctant[o] = cache[o]->data();
-    }
+    out.held[o] = cache[o];
+    out.byOctant[o] = cache[o]->data();
   }
   return out;
 }

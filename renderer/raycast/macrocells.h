@@ -58,17 +58,22 @@ class MacrocellGrid {
   double buildSeconds() const { return buildSeconds_; }
 
   // The fields rays leap by, one per direction octant (bit a set: the ray
-  // goes down axis a; octantOf in kernel.h): for the octants in the mask
-  // `wanted`, forwardLeapDistance's field (leap_distance.h), built over the
-  // pool on first use after classify() and kept; for the others, and for
-  // those beyond kForwardFieldsKept, distance(), which is as safe and leaps
-  // less far. Holds what it hands out alive until the result goes.
-  static constexpr int kForwardFieldsKept = 4;  // a byte per macrocell each
+  // goes down axis a; octantOf in kernel.h): for the first
+  // forwardFieldsKept() octants of `wanted` (most rays first,
+  // frameOctants), forwardLeapDistance's field (leap_distance.h), built
+  // over the pool on first use after classify() and kept while frames want
+  // it; for every other octant distance(), which is as safe and leaps less
+  // far. Holds what it hands out alive until the result goes.
   struct LeapFields {
     const std::uint8_t* byOctant[8];
     std::shared_ptr<const std::vector<std::uint8_t>> held[8];
   };
-  LeapFields leapFields(unsigned wanted, ThreadPool* pool = nullptr) const;
+  LeapFields leapFields(const std::vector<int>& wanted, ThreadPool* pool = nullptr) const;
+  // How many forward fields are kept at most: a byte per macrocell each,
+  // together at most 1/64 of the brick's voxel bytes (issue 11 allows a
+  // rank 1.1x its share of the volume, and it uses about 1.08x): one for
+  // 8-bit data (a macrocell holds 64 voxels), two for 16-bit, four beyond.
+  int forwardFieldsKept() const;
 
  private:
   void findVisibleBox();  // visibleFirst_ and visibleLast_ from distance_
