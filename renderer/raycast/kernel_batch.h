@@ -283,7 +283,8 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
 #ifdef PVR_HAVE_PREINT_LANES
   // Lane 7 of `before`: the next segment's front end, at node frontNode
   // (stale after a batch of empty cells).
-  preint::Ends8 before = preint::broadcast(frontEnd);
+  preint::StoredEnds before;
+  preint::store(frontEnd, before);
   float frontNode = frontScalar;
   bool frontStale = false;
 #endif
@@ -321,7 +322,7 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
       advance(s, count, after, lo8, hi8);
       continue;
     }
-    if (frontStale) before = preint::broadcast(preint::endAt(p.preint, frontNode));
+    if (frontStale) preint::store(preint::endAt(p.preint, frontNode), before);
     frontStale = false;
     frontNode = nextFront;
     const preint::Ends8 backs = preint::endsAt(p.preint, node);
@@ -352,7 +353,7 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
       alignas(32) double out[4];
       _mm256_store_pd(out, gathered);
       acc = {out[0], out[1], out[2], out[3]};
-      before = backs;
+      preint::store(backs, before);
       advance(s, count, after, lo8, hi8);
       if (acc.a >= p.earlyTermination) return true;
       continue;
@@ -371,7 +372,7 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
       _mm512_store_pd(backX, backs.x);
       _mm512_store_pd(frontX, fronts.x);
     }
-    before = backs;
+    preint::store(backs, before);
     // Composite the segments that add anything, in order.
     unsigned lanes = valid & (unsigned(_mm512_cmp_pd_mask(seg.a, _mm512_setzero_pd(), _CMP_GT_OQ)) | seg.opaque);
     for (; lanes; lanes &= lanes - 1) {

@@ -139,40 +139,62 @@ struct Ends8 {
   return low == 0xFF || high == 0xFF;
 }
 
+// The eight ends of a batch kept in memory, field by field, for the next
+// batch's fronts (lane 7: the next segment's front end). Carried in
+// registers, the 14 vectors of a batch's ends outlived the batch and the
+// compiler spilled them and others around the segment arithmetic; stored
+// once here, the next batch reads lane 7 of each with a broadcast load.
+struct StoredEnds {
+  enum Field { kX, kTau, kT, kM, kK0, kK1, kK2, kO, kk0, kk1, kk2, kOpaque, kFields };
+  alignas(64) double lanes[kFields][8];
+};
+
+[[gnu::always_inline]] inline void store(const Ends8& e, StoredEnds& s) {
+  _mm512_store_pd(s.lanes[StoredEnds::kX], e.x);
+  _mm512_store_pd(s.lanes[StoredEnds::kTau], e.tau);
+  _mm512_store_pd(s.lanes[StoredEnds::kT], e.T);
+  _mm512_store_pd(s.lanes[StoredEnds::kM], e.M);
+  _mm512_store_pd(s.lanes[StoredEnds::kO], e.O);
+  _mm512_store_pd(s.lanes[StoredEnds::kOpaque], e.opaque);
+  for (int c = 0; c < 3; ++c) {
+    _mm512_store_pd(s.lanes[StoredEnds::kK0 + c], e.K[c]);
+    _mm512_store_pd(s.lanes[StoredEnds::kk0 + c], e.k[c]);
+  }
+}
+
+// One End as lane 7 of `s` (the other lanes are not read).
+inline void store(const End& end, StoredEnds& s) {
+  s.lanes[StoredEnds::kX][7] = end.x;
+  s.lanes[StoredEnds::kTau][7] = end.tau;
+  s.lanes[StoredEnds::kT][7] = end.T;
+  s.lanes[StoredEnds::kM][7] = end.M;
+  s.lanes[StoredEnds::kO][7] = end.O;
+  s.lanes[StoredEnds::kOpaque][7] = end.opaque;
+  for (int c = 0; c < 3; ++c) {
+    s.lanes[StoredEnds::kK0 + c][7] = end.K[c];
+    s.lanes[StoredEnds::kk0 + c][7] = end.k[c];
+  }
+}
+
 // The eight ends before these: lane 0 from lane 7 of `before`, lane j from
 // lane j - 1 of `e` (the back end of one segment is the front of the next).
-[[gnu::always_inline]] inline Ends8 fronts(const Ends8& before, const Ends8& e) {
-  auto shift = [](__m512d b, __m512d a) __attribute__((always_inline)) {
+[[gnu::always_inline]] inline Ends8 fronts(const StoredEnds& before, const Ends8& e) {
+  auto shift = [&](int field, __m512d a) __attribute__((always_inline)) {
+    const __m512d b = _mm512_set1_pd(before.lanes[field][7]);
     return _mm512_castsi512_pd(_mm512_maskz_alignr_epi64(kAll, _mm512_castpd_si512(a), _mm512_castpd_si512(b), 7));
   };
   Ends8 f;
-  f.x = shift(before.x, e.x);
-  f.tau = shift(before.tau, e.tau);
-  f.T = shift(before.T, e.T);
-  f.M = shift(before.M, e.M);
-  f.O = shift(before.O, e.O);
-  f.opaque = shift(before.opaque, e.opaque);
+  f.x = shift(StoredEnds::kX, e.x);
+  f.tau = shift(StoredEnds::kTau, e.tau);
+  f.T = shift(StoredEnds::kT, e.T);
+  f.M = shift(StoredEnds::kM, e.M);
+  f.O = shift(StoredEnds::kO, e.O);
+  f.opaque = shift(StoredEnds::kOpaque, e.opaque);
   for (int c = 0; c < 3; ++c) {
-    f.K[c] = shift(before.K[c], e.K[c]);
-    f.k[c] = shift(before.k[c], e.k[c]);
+    f.K[c] = shift(StoredEnds::kK0 + c, e.K[c]);
+    f.k[c] = shift(StoredEnds::kk0 + c, e.k[c]);
   }
   return f;
-}
-
-// Eight lanes all holding one End (lane 7 is what fronts() reads).
-inline Ends8 broadcast(const End& end) {
-  Ends8 e;
-  e.x = _mm512_set1_pd(end.x);
-  e.tau = _mm512_set1_pd(end.tau);
-  e.T = _mm512_set1_pd(end.T);
-  e.M = _mm512_set1_pd(end.M);
-  e.O = _mm512_set1_pd(end.O);
-  e.opaque = _mm512_set1_pd(end.opaque);
-  for (int c = 0; c < 3; ++c) {
-    e.K[c] = _mm512_set1_pd(end.K[c]);
-    e.k[c] = _mm512_set1_pd(end.k[c]);
-  }
-  return e;
 }
 
 // 1 / x: the 14-bit estimate and kNewton Newton steps, each doubling its

@@ -131,7 +131,9 @@ TEST_CASE("eight pre-integrated segments at once equal one at a time", "[preinte
     }
     for (double length : {0.3, 2.0}) {
       const preint::Ends8 backs = preint::endsAt(t, _mm256_loadu_ps(ends + 1));
-      const preint::Ends8 fronts = preint::fronts(preint::broadcast(preint::endAt(t, ends[0])), backs);
+      preint::StoredEnds before;
+      preint::store(preint::endAt(t, ends[0]), before);
+      const preint::Ends8 fronts = preint::fronts(before, backs);
       const preint::Segments8 lanes = preint::segments<true>(fronts, backs, length);
       alignas(64) double r[8], g[8], b[8], a[8], centre[8];
       _mm512_store_pd(r, lanes.r);
