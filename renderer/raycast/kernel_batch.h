@@ -256,7 +256,9 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   // The window at `start` (preintWindow()): the samples at start - 1 ..
   // start + 6 in one batch; the front node at `start`, and the sample at
   // start + 1 and its range for the first batch's first node.
+#ifndef PVR_HAVE_PREINT_LANES
   preint::End frontEnd;
+#endif
   float frontScalar;
   {
     alignas(32) float first[8], firstLo[8], firstHi[8];
@@ -266,7 +268,9 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     _mm256_store_ps(firstHi, hi8);
     frontScalar = curvedNode<T>(first[0], first[1], first[2], firstLo[1], firstHi[1]);
     if (!finite<T>(frontScalar)) frontScalar = 0;  // looked up as 0 (segmentEnd())
+#ifndef PVR_HAVE_PREINT_LANES
     frontEnd = preint::endAt(p.preint, frontScalar);
+#endif
     carried = _mm256_set_ps(first[2], first[1], 0, 0, 0, 0, 0, 0);
     carriedLo = _mm256_set1_ps(firstLo[2]);
     carriedHi = _mm256_set1_ps(firstHi[2]);
@@ -282,12 +286,22 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   };
 #ifdef PVR_HAVE_PREINT_LANES
   // Lane 7 of `before`: the next segment's front end, at node frontNode
-  // (stale after a batch of empty cells).
+  // (stale after a batch of empty cells, and before the first batch).
+  // Unshaded through a table without opaque nodes, the rows look-up
+  // (preint_lanes.h spansAt()) with one row of the last end carried
+  // (beforeRow); else the cells' (endsAt()).
   preint::StoredEnds before;
-  preint::store(frontEnd, before);
+  preint::RowEnd beforeRow;
   float frontNode = frontScalar;
-  bool frontStale = false;
+  bool frontStale = true;  // looked up by the first batch that needs it
+  using Rows = std::true_type;
+  using Cells = std::false_type;
+#else
+  using Cells = std::false_type;
 #endif
+  // The batches, with rows or cells (two loops, the choice made once).
+  auto batches = [&](auto lookUp) __attribute__((always_inline)) -> bool {
+  constexpr bool kRows = decltype(lookUp)::value;
   for (std::int64_t s = start; s + kFullBatchesOnly < exit; s += 8) {
     // The samples at s + 2 .. s + 9 (after), and at s .. s + 7 and s + 1 .. s + 8.
     __m256 lo8, hi8;
@@ -322,12 +336,26 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
       advance(s, count, after, lo8, hi8);
       continue;
     }
-    if (frontStale) preint::store(preint::endAt(p.preint, frontNode), before);
+    if (frontStale) {
+      if constexpr (kRows) beforeRow = preint::rowEnd(p.preint, frontNode);
+      else preint::store(preint::endAt(p.preint, frontNode), before);
+    }
     frontStale = false;
     frontNode = nextFront;
-    const preint::Ends8 backs = preint::endsAt(p.preint, node);
-    const preint::Ends8 fronts = preint::fronts(before, backs);
-    const preint::Segments8 seg = preint::segments<kShaded>(fronts, backs, p.stepLength);
+    preint::Segments8 seg;
+    alignas(64) double frontX[8], backX[8];  // of opaque segments
+    if constexpr (kRows) {
+      seg = preint::integrate<false>(preint::spansAt(p.preint, node, beforeRow), p.stepLength);
+    } else {
+      const preint::Ends8 backs = preint::endsAt(p.preint, node);
+      const preint::Ends8 fronts = preint::fronts(before, backs);
+      seg = preint::segments<kShaded>(fronts, backs, p.stepLength);
+      preint::store(backs, before);
+      if (seg.opaque) {
+        _mm512_store_pd(backX, backs.x);
+        _mm512_store_pd(frontX, fronts.x);
+      }
+    }
     if (!seg.opaque) {
       // With no opaque segment (those take the loop below), the eight
       // segments are composited with each other as plain samples are
@@ -353,7 +381,6 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
       alignas(32) double out[4];
       _mm256_store_pd(out, gathered);
       acc = {out[0], out[1], out[2], out[3]};
-      preint::store(backs, before);
       advance(s, count, after, lo8, hi8);
       if (acc.a >= p.earlyTermination) return true;
       continue;
@@ -367,12 +394,6 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
       _mm256_store_ps(centre, _mm512_maskz_cvtpd_ps(preint::kAll, seg.centre));
       _mm256_store_ps(spread, _mm512_maskz_cvtpd_ps(preint::kAll, seg.spread));
     }
-    alignas(64) double frontX[8], backX[8];
-    if (seg.opaque) {
-      _mm512_store_pd(backX, backs.x);
-      _mm512_store_pd(frontX, fronts.x);
-    }
-    preint::store(backs, before);
     // Composite the segments that add anything, in order.
     unsigned lanes = valid & (unsigned(_mm512_cmp_pd_mask(seg.a, _mm512_setzero_pd(), _CMP_GT_OQ)) | seg.opaque);
     for (; lanes; lanes &= lanes - 1) {
@@ -411,6 +432,11 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     if (acc.a >= p.earlyTermination) return true;
   }
   return false;
+  };
+#ifdef PVR_HAVE_PREINT_LANES
+  if (!kShaded && !p.preint.opaqueNodes) return batches(Rows{});
+#endif
+  return batches(Cells{});
 }
 
 }  // namespace pvr::core::kernel

@@ -253,14 +253,49 @@ struct Segments8 {
   __mmask8 opaque;
 };
 
+// What segments() needs of eight segments' two ends: their differences
+// (the integrals across each segment) and sums (for the ends' mean).
+struct Spans8 {
+  __m512d fx, dx;           // the front's table coordinate; back minus front
+  __m512d dT, dK[3];        // back minus front
+  __m512d sumTau, sumK[3];  // front plus back (point values)
+  __m512d dM, frontTau, backTau;  // with kCentre only
+  __mmask8 opaque = 0;      // lanes that reach an opaque scalar
+};
+
+template <bool kCentre>
+[[gnu::always_inline]] inline Segments8 integrate(const Spans8& e, double length);
+
 template <bool kCentre>
 [[gnu::always_inline]] inline Segments8 segments(const Ends8& f, const Ends8& b, double length) {
+  const __m512d zero = _mm512_setzero_pd();
+  Spans8 e;
+  e.fx = f.x;
+  e.dx = _mm512_sub_pd(b.x, f.x);
+  const __mmask8 wide = _mm512_cmp_pd_mask(_mm512_abs_pd(e.dx), _mm512_set1_pd(kMinSpan), _CMP_GT_OQ);
+  e.opaque = (wide & _mm512_cmp_pd_mask(b.O, f.O, _CMP_NEQ_UQ)) | _mm512_cmp_pd_mask(f.opaque, zero, _CMP_GT_OQ) |
+             _mm512_cmp_pd_mask(b.opaque, zero, _CMP_GT_OQ);
+  e.dT = _mm512_sub_pd(b.T, f.T);
+  e.sumTau = _mm512_add_pd(f.tau, b.tau);
+  for (int c = 0; c < 3; ++c) {
+    e.dK[c] = _mm512_sub_pd(b.K[c], f.K[c]);
+    e.sumK[c] = _mm512_add_pd(f.k[c], b.k[c]);
+  }
+  if constexpr (kCentre) {
+    e.dM = _mm512_sub_pd(b.M, f.M);
+    e.frontTau = f.tau;
+    e.backTau = b.tau;
+  }
+  return integrate<kCentre>(e, length);
+}
+
+template <bool kCentre>
+[[gnu::always_inline]] inline Segments8 integrate(const Spans8& e, double length) {
   Segments8 s;
   const __m512d zero = _mm512_setzero_pd(), half = _mm512_set1_pd(0.5);
-  const __m512d dx = _mm512_sub_pd(b.x, f.x);
+  const __m512d dx = e.dx;
   const __mmask8 wide = _mm512_cmp_pd_mask(_mm512_abs_pd(dx), _mm512_set1_pd(kMinSpan), _CMP_GT_OQ);
-  s.opaque = (wide & _mm512_cmp_pd_mask(b.O, f.O, _CMP_NEQ_UQ)) | _mm512_cmp_pd_mask(f.opaque, zero, _CMP_GT_OQ) |
-             _mm512_cmp_pd_mask(b.opaque, zero, _CMP_GT_OQ);
+  s.opaque = e.opaque;
   // Mean extinction and colour: difference quotients where the ends are
   // apart, the ends' mean where they are not.
   // 1/dx and 1/tau scale their products by 1 + 4e-9 at most (one Newton
@@ -268,13 +303,11 @@ template <bool kCentre>
   // to float. The centroid's reciprocals keep two steps: its quotient is a
   // table coordinate (up to 4095) from which the front's is subtracted.
   const __m512d inv = reciprocal<1>(dx);  // used where wide only
-  const __m512d dT = _mm512_sub_pd(b.T, f.T);
-  const __m512d tau = _mm512_mask_blend_pd(wide, _mm512_mul_pd(half, _mm512_add_pd(f.tau, b.tau)),
-                                           _mm512_mul_pd(dT, inv));
+  const __m512d dT = e.dT;
+  const __m512d tau = _mm512_mask_blend_pd(wide, _mm512_mul_pd(half, e.sumTau), _mm512_mul_pd(dT, inv));
   __m512d k[3];
   for (int c = 0; c < 3; ++c)
-    k[c] = _mm512_mask_blend_pd(wide, _mm512_mul_pd(half, _mm512_add_pd(f.k[c], b.k[c])),
-                                _mm512_mul_pd(_mm512_sub_pd(b.K[c], f.K[c]), inv));
+    k[c] = _mm512_mask_blend_pd(wide, _mm512_mul_pd(half, e.sumK[c]), _mm512_mul_pd(e.dK[c], inv));
   const __mmask8 visible = _mm512_cmp_pd_mask(tau, zero, _CMP_GT_OQ) & ~s.opaque;
   const __m512d depth = _mm512_mul_pd(tau, _mm512_set1_pd(length));
   const __m512d alpha = _mm512_maskz_sub_pd(visible, zero, expm1NonPositive(_mm512_sub_pd(zero, depth)));
@@ -287,12 +320,11 @@ template <bool kCentre>
   if constexpr (kCentre) {
     // The extinction's centroid, then moved frontwards by self-attenuation
     // (segment()): 1/D - 1/(e^D - 1) - 1/2, with 1/(e^D - 1) = (1 - alpha) / alpha.
-    const __m512d sum = _mm512_add_pd(f.tau, b.tau);
-    const __m512d num = _mm512_mask_blend_pd(wide, _mm512_fmadd_pd(_mm512_set1_pd(2.0), b.tau, f.tau),
-                                             _mm512_sub_pd(b.M, f.M));
+    const __m512d sum = e.sumTau;
+    const __m512d num = _mm512_mask_blend_pd(wide, _mm512_fmadd_pd(_mm512_set1_pd(2.0), e.backTau, e.frontTau), e.dM);
     const __m512d den = _mm512_mask_blend_pd(wide, _mm512_mul_pd(_mm512_set1_pd(3.0), sum), dT);
     const __m512d quotient = _mm512_mul_pd(num, reciprocal<2>(den));
-    __m512d at = _mm512_mask_blend_pd(wide, quotient, _mm512_mul_pd(_mm512_sub_pd(quotient, f.x), inv));
+    __m512d at = _mm512_mask_blend_pd(wide, quotient, _mm512_mul_pd(_mm512_sub_pd(quotient, e.fx), inv));
     at = _mm512_mask_blend_pd(wide | _mm512_cmp_pd_mask(sum, zero, _CMP_GT_OQ), half, at);
     const __m512d one = _mm512_set1_pd(1.0);
     const __m512d inverseDepth = reciprocal<2>(depth), inverseAlpha = reciprocal<2>(alpha);
@@ -309,6 +341,98 @@ template <bool kCentre>
     s.spread = _mm512_maskz_sqrt_pd(kAll, _mm512_maskz_max_pd(kAll, variance, zero));
   }
   return s;
+}
+
+// The rows look-up (PreintegralRows), for tables without opaque nodes and
+// segments not lit: each end is one row, T K0 K1 K2 | tau k0 k1 k2 at its
+// scalar, computed with endsAt()'s operations (so equal to it to the ulp
+// that the compiler's fusing of a multiply and an add may change);
+// a segment's differences and sums are one fused multiply-add of two
+// consecutive rows, and one 8x8 transpose makes them vectors across the
+// eight segments. Precision: the rows hold endAt()'s double values and
+// the differences are the same double subtractions, so a segment's
+// integral T(b) - T(f) errs by at most an ulp of the larger cumulative
+// sum (1.1e-16 times T of the table's top, which is below 4095 times the
+// largest extinction): relative to the segment's own integral, below the
+// 1e-7 the image needs wherever that integral is above 5e-6 of the
+// table's largest cell integral (one more decimal than the float colour
+// that the segment's result is rounded to can show), the same as before.
+//
+// Table coordinates of eight scalars: x, clamped into the table (xc), the
+// cell, the fraction across it and the part beyond the table.
+struct Coordinates8 {
+  __m512d x, w, beyond;
+  __m256i cell;
+};
+
+[[gnu::always_inline]] inline Coordinates8 coordinates(const PreintegralTables& t, __m256 scalar) {
+  Coordinates8 c;
+  c.x = _mm512_add_pd(_mm512_mul_pd(_mm512_maskz_cvtps_pd(kAll, scalar), _mm512_set1_pd(double(t.scale))),
+                      _mm512_set1_pd(double(t.offset)));
+  const __m512d xc = _mm512_maskz_min_pd(kAll, _mm512_maskz_max_pd(kAll, c.x, _mm512_setzero_pd()), _mm512_set1_pd(double(t.entries - 1)));
+  c.cell = _mm256_min_epi32(_mm512_maskz_cvttpd_epi32(kAll, xc), _mm256_set1_epi32(t.entries - 2));
+  c.w = _mm512_sub_pd(xc, _mm512_maskz_cvtepi32_pd(kAll, c.cell));
+  c.beyond = _mm512_sub_pd(c.x, xc);
+  return c;
+}
+
+// One end's row from its cell's rows, w and beyond in every lane: the
+// integrals T_i + w (f_a + w/2 df) + beyond f(end) and the points
+// f_a + w df, in endAt()'s operations.
+[[gnu::always_inline]] inline __m512d endRow(const PreintegralRows& r, __m512d w, __m512d beyond) {
+  const __m512d value = _mm512_load_pd(r.value);
+  const __m512d t1 = _mm512_fmadd_pd(w, _mm512_load_pd(r.curve), _mm512_load_pd(r.slope));  // points: df
+  const __m512d row = _mm512_mask_blend_pd(0xF0, _mm512_add_pd(value, _mm512_mul_pd(w, t1)),
+                                           _mm512_fmadd_pd(w, t1, value));
+  // Beyond the table the integrals go on with the end's point values.
+  return _mm512_mask3_fmadd_pd(beyond, _mm512_maskz_shuffle_f64x2(kAll, row, row, 0x4E), row, 0x0F);
+}
+
+// The row of the end before the next batch's first: lane 7's.
+struct RowEnd {
+  __m512d row;
+  double x;
+};
+
+// The row of one scalar, as spansAt() computes it.
+inline RowEnd rowEnd(const PreintegralTables& t, float scalar) {
+  const Coordinates8 c = coordinates(t, _mm256_set1_ps(scalar));
+  const int cell = _mm256_cvtsi256_si32(c.cell);
+  return {endRow(t.rows[cell], c.w, c.beyond), _mm512_cvtsd_f64(c.x)};
+}
+
+// The eight segments ending at these scalars, the first starting at
+// `before`, which becomes the last of them.
+[[gnu::always_inline]] inline Spans8 spansAt(const PreintegralTables& t, __m256 scalar, RowEnd& before) {
+  const Coordinates8 c = coordinates(t, scalar);
+  alignas(64) double w[8], beyond[8], x[8];
+  alignas(32) std::int32_t cell[8];
+  _mm512_store_pd(w, c.w);
+  _mm512_store_pd(beyond, c.beyond);
+  _mm512_store_pd(x, c.x);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(cell), c.cell);
+  // Back minus front in lanes 0-3 (integrals), plus in lanes 4-7 (points).
+  const __m512d sign = _mm512_setr_pd(-1, -1, -1, -1, 1, 1, 1, 1);
+  __m512d d[8];
+  __m512d previous = before.row;
+  for (int j = 0; j < 8; ++j) {
+    const __m512d row = endRow(t.rows[cell[j]], _mm512_set1_pd(w[j]), _mm512_set1_pd(beyond[j]));
+    d[j] = _mm512_fmadd_pd(sign, previous, row);
+    previous = row;
+  }
+  transpose8x8(d);
+  Spans8 e;
+  e.fx = _mm512_castsi512_pd(_mm512_maskz_alignr_epi64(kAll, _mm512_castpd_si512(c.x),
+                                                       _mm512_castpd_si512(_mm512_set1_pd(before.x)), 7));
+  e.dx = _mm512_sub_pd(c.x, e.fx);
+  e.dT = d[0];
+  e.sumTau = d[4];
+  for (int k = 0; k < 3; ++k) {
+    e.dK[k] = d[1 + k];
+    e.sumK[k] = d[5 + k];
+  }
+  before = {previous, x[7]};
+  return e;
 }
 
 }  // namespace pvr::core::preint
