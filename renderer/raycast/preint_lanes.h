@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <type_traits>
 
 #include "../preintegration.h"
 
@@ -379,11 +380,14 @@ struct Coordinates8 {
 // One end's row from its cell's rows, w and beyond in every lane: the
 // integrals T_i + w (f_a + w/2 df) + beyond f(end) and the points
 // f_a + w df, in endAt()'s operations.
+// Without kBeyond, `beyond` is taken as 0 (no lane of the batch is beyond
+// the table).
+template <bool kBeyond = true>
 [[gnu::always_inline]] inline __m512d endRow(const PreintegralRows& r, __m512d w, __m512d beyond) {
   const __m512d value = _mm512_load_pd(r.value);
   const __m512d t1 = _mm512_fmadd_pd(w, _mm512_load_pd(r.curve), _mm512_load_pd(r.slope));  // points: df
-  const __m512d row = _mm512_mask_blend_pd(0xF0, _mm512_add_pd(value, _mm512_mul_pd(w, t1)),
-                                           _mm512_fmadd_pd(w, t1, value));
+  const __m512d row = _mm512_fmadd_pd(w, t1, value);
+  if constexpr (!kBeyond) return row;
   // Beyond the table the integrals go on with the end's point values.
   return _mm512_mask3_fmadd_pd(beyond, _mm512_maskz_shuffle_f64x2(kAll, row, row, 0x4E), row, 0x0F);
 }
@@ -415,11 +419,18 @@ inline RowEnd rowEnd(const PreintegralTables& t, float scalar) {
   const __m512d sign = _mm512_setr_pd(-1, -1, -1, -1, 1, 1, 1, 1);
   __m512d d[8];
   __m512d previous = before.row;
-  for (int j = 0; j < 8; ++j) {
-    const __m512d row = endRow(t.rows[cell[j]], _mm512_set1_pd(w[j]), _mm512_set1_pd(beyond[j]));
-    d[j] = _mm512_fmadd_pd(sign, previous, row);
-    previous = row;
-  }
+  auto ends = [&](auto beyondTag) __attribute__((always_inline)) {
+    for (int j = 0; j < 8; ++j) {
+      const __m512d row = endRow<decltype(beyondTag)::value>(t.rows[cell[j]], _mm512_set1_pd(w[j]),
+                                                             _mm512_set1_pd(beyond[j]));
+      d[j] = _mm512_fmadd_pd(sign, previous, row);
+      previous = row;
+    }
+  };
+  // Scalars beyond the table's ends are rare (data outside the transfer
+  // function's points).
+  if (_mm512_cmp_pd_mask(c.beyond, _mm512_setzero_pd(), _CMP_NEQ_UQ)) ends(std::true_type{});
+  else ends(std::false_type{});
   transpose8x8(d);
   Spans8 e;
   e.fx = _mm512_castsi512_pd(_mm512_maskz_alignr_epi64(kAll, _mm512_castpd_si512(c.x),
