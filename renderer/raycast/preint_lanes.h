@@ -57,17 +57,34 @@ struct Ends8 {
   }
 }
 
+// Table coordinates of eight scalars: x, clamped into the table (xc), the
+// cell, the fraction across it and the part beyond the table.
+struct Coordinates8 {
+  __m512d x, xc, w, beyond;
+  __m256i cell;
+};
+
+[[gnu::always_inline]] inline Coordinates8 coordinates(const PreintegralTables& t, __m256 scalar) {
+  Coordinates8 c;
+  c.x = _mm512_add_pd(_mm512_mul_pd(_mm512_maskz_cvtps_pd(kAll, scalar), _mm512_set1_pd(double(t.scale))),
+                      _mm512_set1_pd(double(t.offset)));
+  c.xc = _mm512_maskz_min_pd(kAll, _mm512_maskz_max_pd(kAll, c.x, _mm512_setzero_pd()),
+                              _mm512_set1_pd(double(t.entries - 1)));
+  c.cell = _mm256_min_epi32(_mm512_maskz_cvttpd_epi32(kAll, c.xc), _mm256_set1_epi32(t.entries - 2));
+  c.w = _mm512_sub_pd(c.xc, _mm512_maskz_cvtepi32_pd(kAll, c.cell));
+  c.beyond = _mm512_sub_pd(c.x, c.xc);
+  return c;
+}
+
 // endAt() of eight finite scalars.
 [[gnu::always_inline]] inline Ends8 endsAt(const PreintegralTables& t, __m256 scalar) {
   Ends8 e;
-  e.x = _mm512_add_pd(_mm512_mul_pd(_mm512_maskz_cvtps_pd(kAll, scalar), _mm512_set1_pd(double(t.scale))),
-                      _mm512_set1_pd(double(t.offset)));
-  const __m512d xc = _mm512_maskz_min_pd(kAll, _mm512_maskz_max_pd(kAll, e.x, _mm512_setzero_pd()), _mm512_set1_pd(double(t.entries - 1)));
-  const __m256i i = _mm256_min_epi32(_mm512_maskz_cvttpd_epi32(kAll, xc), _mm256_set1_epi32(t.entries - 2));
-  const __m512d di = _mm512_maskz_cvtepi32_pd(kAll, i);
-  const __m512d w = _mm512_sub_pd(xc, di), beyond = _mm512_sub_pd(e.x, xc);
+  const Coordinates8 at = coordinates(t, scalar);
+  e.x = at.x;
+  const __m512d xc = at.xc, di = _mm512_maskz_cvtepi32_pd(kAll, at.cell);
+  const __m512d w = at.w, beyond = at.beyond;
   alignas(32) std::int32_t cell[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(cell), i);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(cell), at.cell);
   __m512d row0[8], row1[8];
   for (int j = 0; j < 8; ++j) {
     const double* c = &t.cells[cell[j]].tau;
@@ -365,24 +382,6 @@ template <bool kCentre>
 // exact to an ulp. Float rows would not be cheaper: converting 16 float
 // fields to double takes the shuffle-port work of the second transpose.
 //
-// Table coordinates of eight scalars: x, clamped into the table (xc), the
-// cell, the fraction across it and the part beyond the table.
-struct Coordinates8 {
-  __m512d x, w, beyond;
-  __m256i cell;
-};
-
-[[gnu::always_inline]] inline Coordinates8 coordinates(const PreintegralTables& t, __m256 scalar) {
-  Coordinates8 c;
-  c.x = _mm512_add_pd(_mm512_mul_pd(_mm512_maskz_cvtps_pd(kAll, scalar), _mm512_set1_pd(double(t.scale))),
-                      _mm512_set1_pd(double(t.offset)));
-  const __m512d xc = _mm512_maskz_min_pd(kAll, _mm512_maskz_max_pd(kAll, c.x, _mm512_setzero_pd()), _mm512_set1_pd(double(t.entries - 1)));
-  c.cell = _mm256_min_epi32(_mm512_maskz_cvttpd_epi32(kAll, xc), _mm256_set1_epi32(t.entries - 2));
-  c.w = _mm512_sub_pd(xc, _mm512_maskz_cvtepi32_pd(kAll, c.cell));
-  c.beyond = _mm512_sub_pd(c.x, xc);
-  return c;
-}
-
 // One end's row from its cell's rows, w and beyond in every lane: the
 // integrals T_i + w (f_a + w/2 df) + beyond f(end) and the points
 // f_a + w df, in endAt()'s operations.
