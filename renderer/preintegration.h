@@ -49,6 +49,26 @@ struct alignas(64) PreintegralCell {
 };
 static_assert(sizeof(PreintegralCell) == 128 && offsetof(PreintegralCell, k) == 64);
 
+// The same cell as three rows of the polynomials in w (the coordinate's
+// fraction across the cell) that give a segment end's values, for the
+// batched kernel's unshaded look-up without opaque nodes
+// (preint_lanes.h spansAt()): each end is computed as one row,
+//   lanes 0-3: T, K0, K1, K2 at w:  value + w (slope + w curve),
+//   lanes 4-7: tau, k0, k1, k2 at w: value + w slope (curve 0),
+// so that consecutive ends' differences (integrals) and sums (means) are
+// one vector operation per segment and a single 8x8 transpose turns eight
+// segments into one vector per field; the two-row cell took two
+// transposes and carried 14 vectors of ends from segment to segment. The
+// values are the cell's, in double: differences of the cumulative sums
+// keep the faint segments' digits exactly as PreintegralCell's do (and
+// curve = slope / 2 is exact, so each end is endsAt()'s, to an ulp).
+struct alignas(64) PreintegralRows {
+  double value[8];  // T K0 K1 K2 at node i | tau k0 k1 k2 at node i
+  double slope[8];  // tau k0 k1 k2 at node i | their changes to node i + 1
+  double curve[8];  // their changes to node i + 1, halved | 0
+};
+static_assert(sizeof(PreintegralRows) == 192);
+
 // Where the pre-integration's tables are, for the kernels.
 struct PreintegralTables {
   const PreintegralCell* cells = nullptr;  // `entries` cells (the last one: its node only)
@@ -57,8 +77,10 @@ struct PreintegralTables {
   const std::uint32_t* visibleBelow = nullptr;  // [entries]: cells below cell i with extinction or
                                                // opacity 1 at either node (the batched kernel's
                                                // test for a batch of empty segments)
+  const PreintegralRows* rows = nullptr;   // `entries` cells as rows (PreintegralRows)
   int entries = 0;
   float scale = 0, offset = 0;             // table coordinate = scalar * scale + offset
+  bool opaqueNodes = true;                 // some node has opacity 1 (rows then unused)
   // The empty ends, in table coordinates, with a cell of margin for a
   // coordinate's float rounding: a batch whose ends all lie below
   // `clearBelow`, or all at or above `clearAbove`, integrates nothing

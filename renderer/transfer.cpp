@@ -143,6 +143,19 @@ PreintegratedTable::PreintegratedTable(const TransferFunctionSpec& tf) {
     for (int k = 0; k < 3; ++k) b.K[k] = a.K[k] + 0.5 * (a.k[k] + b.k[k]);
     b.O = a.O + 0.5 * (a.opaque + b.opaque);
   }
+  // The cells as rows (PreintegralRows), for the batched kernel.
+  rows_.resize(std::size_t(n));
+  for (int i = 0; i < n; ++i) {
+    const PreintegralCell& a = cells_[i];
+    PreintegralRows& r = rows_[i];
+    const double value[8] = {a.T, a.K[0], a.K[1], a.K[2], a.tau, a.k[0], a.k[1], a.k[2]};
+    const double slope[8] = {a.tau, a.k[0], a.k[1], a.k[2], a.dtau, a.dk[0], a.dk[1], a.dk[2]};
+    const double curve[8] = {0.5 * a.dtau, 0.5 * a.dk[0], 0.5 * a.dk[1], 0.5 * a.dk[2], 0, 0, 0, 0};
+    std::copy(value, value + 8, r.value);
+    std::copy(slope, slope + 8, r.slope);
+    std::copy(curve, curve + 8, r.curve);
+    if (a.opaque > 0) opaqueNodes_ = true;
+  }
   // Cells that are not empty, counted from the first.
   visibleBelow_.assign(std::size_t(n), 0);
   for (int i = 1; i < n; ++i) {
@@ -183,6 +196,8 @@ PreintegralTables PreintegratedTable::tables() const {
   t.cells = cells_.data();
   t.opaqueColour = opaqueColour_.data();
   t.visibleBelow = visibleBelow_.data();
+  t.rows = rows_.data();
+  t.opaqueNodes = opaqueNodes_;
   t.entries = int(cells_.size());
   t.scale = scale_;
   t.offset = offset_;

@@ -90,6 +90,8 @@ class PreintegratedTable {
  private:
   float scale_ = 0, offset_ = 0;
   std::vector<PreintegralCell> cells_;
+  std::vector<PreintegralRows> rows_;  // cells_ as rows
+  bool opaqueNodes_ = false;
   std::vector<std::uint32_t> visibleBelow_;
   std::vector<Rgba> opaqueColour_;
   float clearBelow_ = -INFINITY, clearAbove_ = INFINITY;  // PreintegralTables

@@ -256,7 +256,9 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   // The window at `start` (preintWindow()): the samples at start - 1 ..
   // start + 6 in one batch; the front node at `start`, and the sample at
   // start + 1 and its range for the first batch's first node.
+#ifndef PVR_HAVE_PREINT_LANES
   preint::End frontEnd;
+#endif
   float frontScalar;
   {
     alignas(32) float first[8], firstLo[8], firstHi[8];
@@ -266,7 +268,9 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     _mm256_store_ps(firstHi, hi8);
     frontScalar = curvedNode<T>(first[0], first[1], first[2], firstLo[1], firstHi[1]);
     if (!finite<T>(frontScalar)) frontScalar = 0;  // looked up as 0 (segmentEnd())
+#ifndef PVR_HAVE_PREINT_LANES
     frontEnd = preint::endAt(p.preint, frontScalar);
+#endif
     carried = _mm256_set_ps(first[2], first[1], 0, 0, 0, 0, 0, 0);
     carriedLo = _mm256_set1_ps(firstLo[2]);
     carriedHi = _mm256_set1_ps(firstHi[2]);
@@ -282,134 +286,157 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   };
 #ifdef PVR_HAVE_PREINT_LANES
   // Lane 7 of `before`: the next segment's front end, at node frontNode
-  // (stale after a batch of empty cells).
-  preint::Ends8 before = preint::broadcast(frontEnd);
+  // (stale after a batch of empty cells, and before the first batch).
+  // Unshaded through a table without opaque nodes, the rows look-up
+  // (preint_lanes.h spansAt()) with one row of the last end carried
+  // (beforeRow); else the cells' (endsAt()).
+  preint::StoredEnds before;
+  preint::RowEnd beforeRow;
   float frontNode = frontScalar;
-  bool frontStale = false;
+  bool frontStale = true;  // looked up by the first batch that needs it
+  using Rows = std::true_type;
+  using Cells = std::false_type;
+#else
+  using Cells = std::false_type;
 #endif
-  for (std::int64_t s = start; s + kFullBatchesOnly < exit; s += 8) {
-    // The samples at s + 2 .. s + 9 (after), and at s .. s + 7 and s + 1 .. s + 8.
-    __m256 lo8, hi8;
-    const __m256 after = aroundBatch(v, p, o, d, s + 2, lo8, hi8);
-    const __m256 before8 = shifted(carried, after, kTwo{}), at = shifted(carried, after, kOne{});
-    const __m256 bend = _mm256_add_ps(_mm256_sub_ps(before8, _mm256_add_ps(at, at)), after);
-    __m256 node = _mm256_sub_ps(at, _mm256_mul_ps(bend, _mm256_set1_ps(1.0f / 12.0f)));
-    const __m256 clamped = _mm256_min_ps(_mm256_max_ps(node, shifted(carriedLo, lo8, kOne{})),
-                                         shifted(carriedHi, hi8, kOne{}));
-    if constexpr (std::is_floating_point_v<T>) {
-      node = _mm256_blendv_ps(at, clamped, finite8(node));
-    } else {
-      node = clamped;
-    }
-    const int count = int(std::min<std::int64_t>(8, exit - s));  // segments of this batch
-#ifdef PVR_HAVE_PREINT_LANES
-    // A segment with a non-finite sample at an end is empty; its node is
-    // looked up as 0 (segmentEnd()).
-    unsigned valid = (1u << count) - 1;
-    if constexpr (std::is_floating_point_v<T>) {
-      node = _mm256_and_ps(node, finite8(node));
-      valid &= unsigned(_mm256_movemask_ps(_mm256_and_ps(finite8(before8), finite8(at))));
-    }
-    // A batch whose nodes all lie in empty cells integrates nothing: skip
-    // the table, count the samples; the front end is looked up again only
-    // when a batch needs it.
-    const float nextFront = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(node, _mm256_set1_epi32(7)));
-    if (preint::allClear(p.preint, node, frontNode) ||
-        (p.preint.gaps && preint::allEmpty(p.preint, node, frontNode))) {
-      frontStale = true;
-      frontNode = nextFront;
-      advance(s, count, after, lo8, hi8);
-      continue;
-    }
-    if (frontStale) before = preint::broadcast(preint::endAt(p.preint, frontNode));
-    frontStale = false;
-    frontNode = nextFront;
-    const preint::Ends8 backs = preint::endsAt(p.preint, node);
-    const preint::Ends8 fronts = preint::fronts(before, backs);
-    const preint::Segments8 seg = preint::segments<kShaded>(fronts, backs, p.stepLength);
-    if (!seg.opaque) {
-      // With no opaque segment (those take the loop below), the eight
-      // segments are composited with each other as plain samples are
-      // (kernel_batch_over.h), then into the ray: one link of the "over"
-      // chain per batch instead of eight.
-      Quads batch = segmentQuads(seg, __mmask8(valid));
-      if constexpr (kShaded) {
-        // Lit: the eight segments' two lighting points (shadeSegment()) lit
-        // as two batches of eight samples (shade_lanes.h) and the two
-        // colours averaged (the opacities are the unlit ones in both, so
-        // stay exact). Lit one lane at a time, each point's gradient read
-        // its 32 nodes with scalar loads: about 40 % of a shaded frame.
-        __m256 u[2][3];
-        litPoints8(o, d, s, seg, u);
-        Quads back = batch;
-        shadeQuads(v, p, ray, u[0], batch);
-        shadeQuads(v, p, ray, u[1], back);
-        for (int j = 0; j < 4; ++j)
-          batch.q[j] = _mm256_mul_ps(_mm256_add_ps(batch.q[j], back.q[j]), _mm256_set1_ps(0.5f));
+  // The batches, with rows or cells (two loops, the choice made once).
+  auto batches = [&](auto lookUp) __attribute__((always_inline)) -> bool {
+    [[maybe_unused]] constexpr bool kRows = decltype(lookUp)::value;  // (AVX-512 only)
+    for (std::int64_t s = start; s + kFullBatchesOnly < exit; s += 8) {
+      // The samples at s + 2 .. s + 9 (after), and at s .. s + 7 and s + 1 .. s + 8.
+      __m256 lo8, hi8;
+      const __m256 after = aroundBatch(v, p, o, d, s + 2, lo8, hi8);
+      const __m256 before8 = shifted(carried, after, kTwo{}), at = shifted(carried, after, kOne{});
+      const __m256 bend = _mm256_add_ps(_mm256_sub_ps(before8, _mm256_add_ps(at, at)), after);
+      __m256 node = _mm256_sub_ps(at, _mm256_mul_ps(bend, _mm256_set1_ps(1.0f / 12.0f)));
+      const __m256 clamped = _mm256_min_ps(_mm256_max_ps(node, shifted(carriedLo, lo8, kOne{})),
+                                           shifted(carriedHi, hi8, kOne{}));
+      if constexpr (std::is_floating_point_v<T>) {
+        node = _mm256_blendv_ps(at, clamped, finite8(node));
+      } else {
+        node = clamped;
       }
-      __m256d gathered = _mm256_setr_pd(acc.r, acc.g, acc.b, acc.a);
-      gathered = addBehind4(gathered, overQuads(batch));
-      alignas(32) double out[4];
-      _mm256_store_pd(out, gathered);
-      acc = {out[0], out[1], out[2], out[3]};
-      before = backs;
+      const int count = int(std::min<std::int64_t>(8, exit - s));  // segments of this batch
+#ifdef PVR_HAVE_PREINT_LANES
+      // A segment with a non-finite sample at an end is empty; its node is
+      // looked up as 0 (segmentEnd()).
+      unsigned valid = (1u << count) - 1;
+      if constexpr (std::is_floating_point_v<T>) {
+        node = _mm256_and_ps(node, finite8(node));
+        valid &= unsigned(_mm256_movemask_ps(_mm256_and_ps(finite8(before8), finite8(at))));
+      }
+      // A batch whose nodes all lie in empty cells integrates nothing: skip
+      // the table, count the samples; the front end is looked up again only
+      // when a batch needs it.
+      const float nextFront = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(node, _mm256_set1_epi32(7)));
+      if (preint::allClear(p.preint, node, frontNode) ||
+          (p.preint.gaps && preint::allEmpty(p.preint, node, frontNode))) {
+        frontStale = true;
+        frontNode = nextFront;
+        advance(s, count, after, lo8, hi8);
+        continue;
+      }
+      if (frontStale) {
+        if constexpr (kRows) beforeRow = preint::rowEnd(p.preint, frontNode);
+        else preint::store(preint::endAt(p.preint, frontNode), before);
+      }
+      frontStale = false;
+      frontNode = nextFront;
+      preint::Segments8 seg;
+      alignas(64) double frontX[8], backX[8];  // of opaque segments
+      if constexpr (kRows) {
+        seg = preint::integrate<false>(preint::spansAt(p.preint, node, beforeRow), p.stepLength);
+      } else {
+        const preint::Ends8 backs = preint::endsAt(p.preint, node);
+        const preint::Ends8 fronts = preint::fronts(before, backs);
+        seg = preint::segments<kShaded>(fronts, backs, p.stepLength);
+        preint::store(backs, before);
+        if (seg.opaque) {
+          _mm512_store_pd(backX, backs.x);
+          _mm512_store_pd(frontX, fronts.x);
+        }
+      }
+      if (!seg.opaque) {
+        // With no opaque segment (those take the loop below), the eight
+        // segments are composited with each other as plain samples are
+        // (kernel_batch_over.h), then into the ray: one link of the "over"
+        // chain per batch instead of eight.
+        Quads batch = segmentQuads(seg, __mmask8(valid));
+        if constexpr (kShaded) {
+          // Lit: the eight segments' two lighting points (shadeSegment()) lit
+          // as two batches of eight samples (shade_lanes.h) and the two
+          // colours averaged (the opacities are the unlit ones in both, so
+          // stay exact). Lit one lane at a time, each point's gradient read
+          // its 32 nodes with scalar loads: about 40 % of a shaded frame.
+          __m256 u[2][3];
+          litPoints8(o, d, s, seg, u);
+          Quads back = batch;
+          shadeQuads(v, p, ray, u[0], batch);
+          shadeQuads(v, p, ray, u[1], back);
+          for (int j = 0; j < 4; ++j)
+            batch.q[j] = _mm256_mul_ps(_mm256_add_ps(batch.q[j], back.q[j]), _mm256_set1_ps(0.5f));
+        }
+        __m256d gathered = _mm256_setr_pd(acc.r, acc.g, acc.b, acc.a);
+        gathered = addBehind4(gathered, overQuads(batch));
+        alignas(32) double out[4];
+        _mm256_store_pd(out, gathered);
+        acc = {out[0], out[1], out[2], out[3]};
+        advance(s, count, after, lo8, hi8);
+        if (acc.a >= p.earlyTermination) return true;
+        continue;
+      }
+      alignas(32) float r[8], g[8], b[8], a[8], centre[8], spread[8];
+      _mm256_store_ps(r, _mm512_maskz_cvtpd_ps(preint::kAll, seg.r));
+      _mm256_store_ps(g, _mm512_maskz_cvtpd_ps(preint::kAll, seg.g));
+      _mm256_store_ps(b, _mm512_maskz_cvtpd_ps(preint::kAll, seg.b));
+      _mm256_store_ps(a, _mm512_maskz_cvtpd_ps(preint::kAll, seg.a));
+      if constexpr (kShaded) {
+        _mm256_store_ps(centre, _mm512_maskz_cvtpd_ps(preint::kAll, seg.centre));
+        _mm256_store_ps(spread, _mm512_maskz_cvtpd_ps(preint::kAll, seg.spread));
+      }
+      // Composite the segments that add anything, in order.
+      unsigned lanes = valid & (unsigned(_mm512_cmp_pd_mask(seg.a, _mm512_setzero_pd(), _CMP_GT_OQ)) | seg.opaque);
+      for (; lanes; lanes &= lanes - 1) {
+        const int lane = __builtin_ctz(lanes);
+        Rgba c{r[lane], g[lane], b[lane], a[lane]};
+        float middle = 0.5f, around = 0.0f;  // opaque segments are lit at their middle (segment())
+        if (seg.opaque & (1u << lane)) {
+          c = preint::opaqueSegment(p.preint, frontX[lane], backX[lane]);
+        } else if constexpr (kShaded) {
+          middle = centre[lane];
+          around = spread[lane];
+        }
+        if constexpr (kShaded) c = shadeSegment(v, p, ray, float(s + lane), 1.0f, middle, around, c);
+        acc.addBehind(c);
+      }
+#else
+      alignas(32) float back[8], raw[9];
+      _mm256_store_ps(back, node);
+      _mm256_storeu_ps(raw, before8);
+      raw[8] = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(at, _mm256_set1_epi32(7)));
+      for (int lane = 0; lane < 8; ++lane) {
+        const preint::End backEnd = segmentEnd<T>(p, back[lane]);
+        float centre = 0.5f, spread = 0.0f;
+        Rgba c = finite<T>(raw[lane]) && finite<T>(raw[lane + 1])
+                     ? preint::segment(p.preint, frontEnd, backEnd, p.stepLength, &centre, &spread)
+                     : Rgba{};
+        frontEnd = backEnd;
+        if constexpr (kShaded) {
+          if (!(c.a > 0)) continue;
+          c = shadeSegment(v, p, ray, float(s + lane), 1.0f, centre, spread, c);
+        }
+        acc.addBehind(c);
+      }
+#endif
       advance(s, count, after, lo8, hi8);
       if (acc.a >= p.earlyTermination) return true;
-      continue;
     }
-    alignas(32) float r[8], g[8], b[8], a[8], centre[8], spread[8];
-    _mm256_store_ps(r, _mm512_maskz_cvtpd_ps(preint::kAll, seg.r));
-    _mm256_store_ps(g, _mm512_maskz_cvtpd_ps(preint::kAll, seg.g));
-    _mm256_store_ps(b, _mm512_maskz_cvtpd_ps(preint::kAll, seg.b));
-    _mm256_store_ps(a, _mm512_maskz_cvtpd_ps(preint::kAll, seg.a));
-    if constexpr (kShaded) {
-      _mm256_store_ps(centre, _mm512_maskz_cvtpd_ps(preint::kAll, seg.centre));
-      _mm256_store_ps(spread, _mm512_maskz_cvtpd_ps(preint::kAll, seg.spread));
-    }
-    alignas(64) double frontX[8], backX[8];
-    if (seg.opaque) {
-      _mm512_store_pd(backX, backs.x);
-      _mm512_store_pd(frontX, fronts.x);
-    }
-    before = backs;
-    // Composite the segments that add anything, in order.
-    unsigned lanes = valid & (unsigned(_mm512_cmp_pd_mask(seg.a, _mm512_setzero_pd(), _CMP_GT_OQ)) | seg.opaque);
-    for (; lanes; lanes &= lanes - 1) {
-      const int lane = __builtin_ctz(lanes);
-      Rgba c{r[lane], g[lane], b[lane], a[lane]};
-      float middle = 0.5f, around = 0.0f;  // opaque segments are lit at their middle (segment())
-      if (seg.opaque & (1u << lane)) {
-        c = preint::opaqueSegment(p.preint, frontX[lane], backX[lane]);
-      } else if constexpr (kShaded) {
-        middle = centre[lane];
-        around = spread[lane];
-      }
-      if constexpr (kShaded) c = shadeSegment(v, p, ray, float(s + lane), 1.0f, middle, around, c);
-      acc.addBehind(c);
-    }
-#else
-    alignas(32) float back[8], raw[9];
-    _mm256_store_ps(back, node);
-    _mm256_storeu_ps(raw, before8);
-    raw[8] = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(at, _mm256_set1_epi32(7)));
-    for (int lane = 0; lane < 8; ++lane) {
-      const preint::End backEnd = segmentEnd<T>(p, back[lane]);
-      float centre = 0.5f, spread = 0.0f;
-      Rgba c = finite<T>(raw[lane]) && finite<T>(raw[lane + 1])
-                   ? preint::segment(p.preint, frontEnd, backEnd, p.stepLength, &centre, &spread)
-                   : Rgba{};
-      frontEnd = backEnd;
-      if constexpr (kShaded) {
-        if (!(c.a > 0)) continue;
-        c = shadeSegment(v, p, ray, float(s + lane), 1.0f, centre, spread, c);
-      }
-      acc.addBehind(c);
-    }
+    return false;
+  };
+#ifdef PVR_HAVE_PREINT_LANES
+  if (!kShaded && !p.preint.opaqueNodes) return batches(Rows{});
 #endif
-    advance(s, count, after, lo8, hi8);
-    if (acc.a >= p.earlyTermination) return true;
-  }
-  return false;
+  return batches(Cells{});
 }
 
 }  // namespace pvr::core::kernel

@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <type_traits>
 
 #include "../preintegration.h"
 
@@ -56,17 +57,34 @@ struct Ends8 {
   }
 }
 
+// Table coordinates of eight scalars: x, clamped into the table (xc), the
+// cell, the fraction across it and the part beyond the table.
+struct Coordinates8 {
+  __m512d x, xc, w, beyond;
+  __m256i cell;
+};
+
+[[gnu::always_inline]] inline Coordinates8 coordinates(const PreintegralTables& t, __m256 scalar) {
+  Coordinates8 c;
+  c.x = _mm512_add_pd(_mm512_mul_pd(_mm512_maskz_cvtps_pd(kAll, scalar), _mm512_set1_pd(double(t.scale))),
+                      _mm512_set1_pd(double(t.offset)));
+  c.xc = _mm512_maskz_min_pd(kAll, _mm512_maskz_max_pd(kAll, c.x, _mm512_setzero_pd()),
+                              _mm512_set1_pd(double(t.entries - 1)));
+  c.cell = _mm256_min_epi32(_mm512_maskz_cvttpd_epi32(kAll, c.xc), _mm256_set1_epi32(t.entries - 2));
+  c.w = _mm512_sub_pd(c.xc, _mm512_maskz_cvtepi32_pd(kAll, c.cell));
+  c.beyond = _mm512_sub_pd(c.x, c.xc);
+  return c;
+}
+
 // endAt() of eight finite scalars.
 [[gnu::always_inline]] inline Ends8 endsAt(const PreintegralTables& t, __m256 scalar) {
   Ends8 e;
-  e.x = _mm512_add_pd(_mm512_mul_pd(_mm512_maskz_cvtps_pd(kAll, scalar), _mm512_set1_pd(double(t.scale))),
-                      _mm512_set1_pd(double(t.offset)));
-  const __m512d xc = _mm512_maskz_min_pd(kAll, _mm512_maskz_max_pd(kAll, e.x, _mm512_setzero_pd()), _mm512_set1_pd(double(t.entries - 1)));
-  const __m256i i = _mm256_min_epi32(_mm512_maskz_cvttpd_epi32(kAll, xc), _mm256_set1_epi32(t.entries - 2));
-  const __m512d di = _mm512_maskz_cvtepi32_pd(kAll, i);
-  const __m512d w = _mm512_sub_pd(xc, di), beyond = _mm512_sub_pd(e.x, xc);
+  const Coordinates8 at = coordinates(t, scalar);
+  e.x = at.x;
+  const __m512d xc = at.xc, di = _mm512_maskz_cvtepi32_pd(kAll, at.cell);
+  const __m512d w = at.w, beyond = at.beyond;
   alignas(32) std::int32_t cell[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(cell), i);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(cell), at.cell);
   __m512d row0[8], row1[8];
   for (int j = 0; j < 8; ++j) {
     const double* c = &t.cells[cell[j]].tau;
@@ -139,40 +157,62 @@ struct Ends8 {
   return low == 0xFF || high == 0xFF;
 }
 
+// The eight ends of a batch kept in memory, field by field, for the next
+// batch's fronts (lane 7: the next segment's front end). Carried in
+// registers, the 14 vectors of a batch's ends outlived the batch and the
+// compiler spilled them and others around the segment arithmetic; stored
+// once here, the next batch reads lane 7 of each with a broadcast load.
+struct StoredEnds {
+  enum Field { kX, kTau, kT, kM, kK0, kK1, kK2, kO, kk0, kk1, kk2, kOpaque, kFields };
+  alignas(64) double lanes[kFields][8];
+};
+
+[[gnu::always_inline]] inline void store(const Ends8& e, StoredEnds& s) {
+  _mm512_store_pd(s.lanes[StoredEnds::kX], e.x);
+  _mm512_store_pd(s.lanes[StoredEnds::kTau], e.tau);
+  _mm512_store_pd(s.lanes[StoredEnds::kT], e.T);
+  _mm512_store_pd(s.lanes[StoredEnds::kM], e.M);
+  _mm512_store_pd(s.lanes[StoredEnds::kO], e.O);
+  _mm512_store_pd(s.lanes[StoredEnds::kOpaque], e.opaque);
+  for (int c = 0; c < 3; ++c) {
+    _mm512_store_pd(s.lanes[StoredEnds::kK0 + c], e.K[c]);
+    _mm512_store_pd(s.lanes[StoredEnds::kk0 + c], e.k[c]);
+  }
+}
+
+// One End as lane 7 of `s` (the other lanes are not read).
+inline void store(const End& end, StoredEnds& s) {
+  s.lanes[StoredEnds::kX][7] = end.x;
+  s.lanes[StoredEnds::kTau][7] = end.tau;
+  s.lanes[StoredEnds::kT][7] = end.T;
+  s.lanes[StoredEnds::kM][7] = end.M;
+  s.lanes[StoredEnds::kO][7] = end.O;
+  s.lanes[StoredEnds::kOpaque][7] = end.opaque;
+  for (int c = 0; c < 3; ++c) {
+    s.lanes[StoredEnds::kK0 + c][7] = end.K[c];
+    s.lanes[StoredEnds::kk0 + c][7] = end.k[c];
+  }
+}
+
 // The eight ends before these: lane 0 from lane 7 of `before`, lane j from
 // lane j - 1 of `e` (the back end of one segment is the front of the next).
-[[gnu::always_inline]] inline Ends8 fronts(const Ends8& before, const Ends8& e) {
-  auto shift = [](__m512d b, __m512d a) __attribute__((always_inline)) {
+[[gnu::always_inline]] inline Ends8 fronts(const StoredEnds& before, const Ends8& e) {
+  auto shift = [&](int field, __m512d a) __attribute__((always_inline)) {
+    const __m512d b = _mm512_set1_pd(before.lanes[field][7]);
     return _mm512_castsi512_pd(_mm512_maskz_alignr_epi64(kAll, _mm512_castpd_si512(a), _mm512_castpd_si512(b), 7));
   };
   Ends8 f;
-  f.x = shift(before.x, e.x);
-  f.tau = shift(before.tau, e.tau);
-  f.T = shift(before.T, e.T);
-  f.M = shift(before.M, e.M);
-  f.O = shift(before.O, e.O);
-  f.opaque = shift(before.opaque, e.opaque);
+  f.x = shift(StoredEnds::kX, e.x);
+  f.tau = shift(StoredEnds::kTau, e.tau);
+  f.T = shift(StoredEnds::kT, e.T);
+  f.M = shift(StoredEnds::kM, e.M);
+  f.O = shift(StoredEnds::kO, e.O);
+  f.opaque = shift(StoredEnds::kOpaque, e.opaque);
   for (int c = 0; c < 3; ++c) {
-    f.K[c] = shift(before.K[c], e.K[c]);
-    f.k[c] = shift(before.k[c], e.k[c]);
+    f.K[c] = shift(StoredEnds::kK0 + c, e.K[c]);
+    f.k[c] = shift(StoredEnds::kk0 + c, e.k[c]);
   }
   return f;
-}
-
-// Eight lanes all holding one End (lane 7 is what fronts() reads).
-inline Ends8 broadcast(const End& end) {
-  Ends8 e;
-  e.x = _mm512_set1_pd(end.x);
-  e.tau = _mm512_set1_pd(end.tau);
-  e.T = _mm512_set1_pd(end.T);
-  e.M = _mm512_set1_pd(end.M);
-  e.O = _mm512_set1_pd(end.O);
-  e.opaque = _mm512_set1_pd(end.opaque);
-  for (int c = 0; c < 3; ++c) {
-    e.K[c] = _mm512_set1_pd(end.K[c]);
-    e.k[c] = _mm512_set1_pd(end.k[c]);
-  }
-  return e;
 }
 
 // 1 / x: the 14-bit estimate and kNewton Newton steps, each doubling its
@@ -231,14 +271,49 @@ struct Segments8 {
   __mmask8 opaque;
 };
 
+// What segments() needs of eight segments' two ends: their differences
+// (the integrals across each segment) and sums (for the ends' mean).
+struct Spans8 {
+  __m512d fx, dx;           // the front's table coordinate; back minus front
+  __m512d dT, dK[3];        // back minus front
+  __m512d sumTau, sumK[3];  // front plus back (point values)
+  __m512d dM, frontTau, backTau;  // with kCentre only
+  __mmask8 opaque = 0;      // lanes that reach an opaque scalar
+};
+
+template <bool kCentre>
+[[gnu::always_inline]] inline Segments8 integrate(const Spans8& e, double length);
+
 template <bool kCentre>
 [[gnu::always_inline]] inline Segments8 segments(const Ends8& f, const Ends8& b, double length) {
+  const __m512d zero = _mm512_setzero_pd();
+  Spans8 e;
+  e.fx = f.x;
+  e.dx = _mm512_sub_pd(b.x, f.x);
+  const __mmask8 wide = _mm512_cmp_pd_mask(_mm512_abs_pd(e.dx), _mm512_set1_pd(kMinSpan), _CMP_GT_OQ);
+  e.opaque = (wide & _mm512_cmp_pd_mask(b.O, f.O, _CMP_NEQ_UQ)) | _mm512_cmp_pd_mask(f.opaque, zero, _CMP_GT_OQ) |
+             _mm512_cmp_pd_mask(b.opaque, zero, _CMP_GT_OQ);
+  e.dT = _mm512_sub_pd(b.T, f.T);
+  e.sumTau = _mm512_add_pd(f.tau, b.tau);
+  for (int c = 0; c < 3; ++c) {
+    e.dK[c] = _mm512_sub_pd(b.K[c], f.K[c]);
+    e.sumK[c] = _mm512_add_pd(f.k[c], b.k[c]);
+  }
+  if constexpr (kCentre) {
+    e.dM = _mm512_sub_pd(b.M, f.M);
+    e.frontTau = f.tau;
+    e.backTau = b.tau;
+  }
+  return integrate<kCentre>(e, length);
+}
+
+template <bool kCentre>
+[[gnu::always_inline]] inline Segments8 integrate(const Spans8& e, double length) {
   Segments8 s;
   const __m512d zero = _mm512_setzero_pd(), half = _mm512_set1_pd(0.5);
-  const __m512d dx = _mm512_sub_pd(b.x, f.x);
+  const __m512d dx = e.dx;
   const __mmask8 wide = _mm512_cmp_pd_mask(_mm512_abs_pd(dx), _mm512_set1_pd(kMinSpan), _CMP_GT_OQ);
-  s.opaque = (wide & _mm512_cmp_pd_mask(b.O, f.O, _CMP_NEQ_UQ)) | _mm512_cmp_pd_mask(f.opaque, zero, _CMP_GT_OQ) |
-             _mm512_cmp_pd_mask(b.opaque, zero, _CMP_GT_OQ);
+  s.opaque = e.opaque;
   // Mean extinction and colour: difference quotients where the ends are
   // apart, the ends' mean where they are not.
   // 1/dx and 1/tau scale their products by 1 + 4e-9 at most (one Newton
@@ -246,13 +321,11 @@ template <bool kCentre>
   // to float. The centroid's reciprocals keep two steps: its quotient is a
   // table coordinate (up to 4095) from which the front's is subtracted.
   const __m512d inv = reciprocal<1>(dx);  // used where wide only
-  const __m512d dT = _mm512_sub_pd(b.T, f.T);
-  const __m512d tau = _mm512_mask_blend_pd(wide, _mm512_mul_pd(half, _mm512_add_pd(f.tau, b.tau)),
-                                           _mm512_mul_pd(dT, inv));
+  const __m512d dT = e.dT;
+  const __m512d tau = _mm512_mask_blend_pd(wide, _mm512_mul_pd(half, e.sumTau), _mm512_mul_pd(dT, inv));
   __m512d k[3];
   for (int c = 0; c < 3; ++c)
-    k[c] = _mm512_mask_blend_pd(wide, _mm512_mul_pd(half, _mm512_add_pd(f.k[c], b.k[c])),
-                                _mm512_mul_pd(_mm512_sub_pd(b.K[c], f.K[c]), inv));
+    k[c] = _mm512_mask_blend_pd(wide, _mm512_mul_pd(half, e.sumK[c]), _mm512_mul_pd(e.dK[c], inv));
   const __mmask8 visible = _mm512_cmp_pd_mask(tau, zero, _CMP_GT_OQ) & ~s.opaque;
   const __m512d depth = _mm512_mul_pd(tau, _mm512_set1_pd(length));
   const __m512d alpha = _mm512_maskz_sub_pd(visible, zero, expm1NonPositive(_mm512_sub_pd(zero, depth)));
@@ -265,12 +338,11 @@ template <bool kCentre>
   if constexpr (kCentre) {
     // The extinction's centroid, then moved frontwards by self-attenuation
     // (segment()): 1/D - 1/(e^D - 1) - 1/2, with 1/(e^D - 1) = (1 - alpha) / alpha.
-    const __m512d sum = _mm512_add_pd(f.tau, b.tau);
-    const __m512d num = _mm512_mask_blend_pd(wide, _mm512_fmadd_pd(_mm512_set1_pd(2.0), b.tau, f.tau),
-                                             _mm512_sub_pd(b.M, f.M));
+    const __m512d sum = e.sumTau;
+    const __m512d num = _mm512_mask_blend_pd(wide, _mm512_fmadd_pd(_mm512_set1_pd(2.0), e.backTau, e.frontTau), e.dM);
     const __m512d den = _mm512_mask_blend_pd(wide, _mm512_mul_pd(_mm512_set1_pd(3.0), sum), dT);
     const __m512d quotient = _mm512_mul_pd(num, reciprocal<2>(den));
-    __m512d at = _mm512_mask_blend_pd(wide, quotient, _mm512_mul_pd(_mm512_sub_pd(quotient, f.x), inv));
+    __m512d at = _mm512_mask_blend_pd(wide, quotient, _mm512_mul_pd(_mm512_sub_pd(quotient, e.fx), inv));
     at = _mm512_mask_blend_pd(wide | _mm512_cmp_pd_mask(sum, zero, _CMP_GT_OQ), half, at);
     const __m512d one = _mm512_set1_pd(1.0);
     const __m512d inverseDepth = reciprocal<2>(depth), inverseAlpha = reciprocal<2>(alpha);
@@ -287,6 +359,96 @@ template <bool kCentre>
     s.spread = _mm512_maskz_sqrt_pd(kAll, _mm512_maskz_max_pd(kAll, variance, zero));
   }
   return s;
+}
+
+// The rows look-up (PreintegralRows), for tables without opaque nodes and
+// segments not lit: each end is one row, T K0 K1 K2 | tau k0 k1 k2 at its
+// scalar, computed with endsAt()'s operations (so equal to it to the ulp
+// that the compiler's fusing of a multiply and an add may change);
+// a segment's differences and sums are one fused multiply-add of two
+// consecutive rows, and one 8x8 transpose makes them vectors across the
+// eight segments. Precision: the rows hold the cells' doubles (curve =
+// slope / 2 exactly) and the differences are the same double
+// subtractions, so the precision is the cells': an end's cumulative T is
+// rounded to half an ulp of at most T's top (below 4095 cells times the
+// densest extinction tau_max), and T(b) - T(f) errs by three such,
+// 3 * 1.1e-16 * 4095 tau_max = 1.4e-12 tau_max; over a wide segment
+// (|dx| > kMinSpan = 1e-2 cells) its mean extinction errs by 1.4e-10
+// tau_max. Relative to the segment's own extinction that is below the
+// 1e-7 the image needs wherever the mean is above 1.4e-3 tau_max, and
+// fainter segments err by less than 1.4e-10 of the densest segment's
+// depth, absolutely: far below the float the opacity is returned in.
+// Narrow segments take the ends' point values (no difference of sums),
+// exact to an ulp. Float rows would not be cheaper: converting 16 float
+// fields to double takes the shuffle-port work of the second transpose.
+//
+// One end's row from its cell's rows, w and beyond in every lane: the
+// integrals T_i + w (f_a + w/2 df) + beyond f(end) and the points
+// f_a + w df, in endAt()'s operations.
+// Without kBeyond, `beyond` is taken as 0 (no lane of the batch is beyond
+// the table).
+template <bool kBeyond = true>
+[[gnu::always_inline]] inline __m512d endRow(const PreintegralRows& r, __m512d w, __m512d beyond) {
+  const __m512d value = _mm512_load_pd(r.value);
+  const __m512d t1 = _mm512_fmadd_pd(w, _mm512_load_pd(r.curve), _mm512_load_pd(r.slope));  // points: df
+  const __m512d row = _mm512_fmadd_pd(w, t1, value);
+  if constexpr (!kBeyond) return row;
+  // Beyond the table the integrals go on with the end's point values.
+  return _mm512_mask3_fmadd_pd(beyond, _mm512_maskz_shuffle_f64x2(kAll, row, row, 0x4E), row, 0x0F);
+}
+
+// The row of the end before the next batch's first: lane 7's.
+struct RowEnd {
+  __m512d row;
+  double x;
+};
+
+// The row of one scalar, as spansAt() computes it.
+inline RowEnd rowEnd(const PreintegralTables& t, float scalar) {
+  const Coordinates8 c = coordinates(t, _mm256_set1_ps(scalar));
+  const int cell = _mm256_cvtsi256_si32(c.cell);
+  return {endRow(t.rows[cell], c.w, c.beyond), _mm512_cvtsd_f64(c.x)};
+}
+
+// The eight segments ending at these scalars, the first starting at
+// `before`, which becomes the last of them.
+[[gnu::always_inline]] inline Spans8 spansAt(const PreintegralTables& t, __m256 scalar, RowEnd& before) {
+  const Coordinates8 c = coordinates(t, scalar);
+  alignas(64) double w[8], beyond[8], x[8];
+  alignas(32) std::int32_t cell[8];
+  _mm512_store_pd(w, c.w);
+  _mm512_store_pd(beyond, c.beyond);
+  _mm512_store_pd(x, c.x);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(cell), c.cell);
+  // Back minus front in lanes 0-3 (integrals), plus in lanes 4-7 (points).
+  const __m512d sign = _mm512_setr_pd(-1, -1, -1, -1, 1, 1, 1, 1);
+  __m512d d[8];
+  __m512d previous = before.row;
+  auto ends = [&](auto beyondTag) __attribute__((always_inline)) {
+    for (int j = 0; j < 8; ++j) {
+      const __m512d row = endRow<decltype(beyondTag)::value>(t.rows[cell[j]], _mm512_set1_pd(w[j]),
+                                                             _mm512_set1_pd(beyond[j]));
+      d[j] = _mm512_fmadd_pd(sign, previous, row);
+      previous = row;
+    }
+  };
+  // Scalars beyond the table's ends are rare (data outside the transfer
+  // function's points).
+  if (_mm512_cmp_pd_mask(c.beyond, _mm512_setzero_pd(), _CMP_NEQ_UQ)) ends(std::true_type{});
+  else ends(std::false_type{});
+  transpose8x8(d);
+  Spans8 e;
+  e.fx = _mm512_castsi512_pd(_mm512_maskz_alignr_epi64(kAll, _mm512_castpd_si512(c.x),
+                                                       _mm512_castpd_si512(_mm512_set1_pd(before.x)), 7));
+  e.dx = _mm512_sub_pd(c.x, e.fx);
+  e.dT = d[0];
+  e.sumTau = d[4];
+  for (int k = 0; k < 3; ++k) {
+    e.dK[k] = d[1 + k];
+    e.sumK[k] = d[5 + k];
+  }
+  before = {previous, x[7]};
+  return e;
 }
 
 }  // namespace pvr::core::preint
