@@ -295,10 +295,8 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   float frontNode = frontScalar;
   bool frontStale = true;  // looked up by the first batch that needs it
   using Rows = std::true_type;
-  using Cells = std::false_type;
-#else
-  using Cells = std::false_type;
 #endif
+  using Cells = std::false_type;
   // The batches, with rows or cells (two loops, the choice made once).
   auto batches = [&](auto lookUp) __attribute__((always_inline)) -> bool {
     [[maybe_unused]] constexpr bool kRows = decltype(lookUp)::value;  // (AVX-512 only)
@@ -366,8 +364,9 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
           // Lit: the eight segments' two lighting points (shadeSegment()) lit
           // as two batches of eight samples (shade_lanes.h) and the two
           // colours averaged (the opacities are the unlit ones in both, so
-          // stay exact). Lit one lane at a time, each point's gradient read
-          // its 32 nodes with scalar loads: about 40 % of a shaded frame.
+          // stay exact). (Lit one lane at a time, each point's gradient reading
+          // its 32 nodes with scalar loads, lighting took about 40 % of a
+          // shaded frame.)
           __m256 u[2][3];
           litPoints8(o, d, s, seg, u);
           Quads back = batch;
