@@ -59,6 +59,20 @@ std::vector<double> frameTimes(const std::vector<comm::Bytes>& perRank, std::siz
   return out;
 }
 
+// Slot s's frame from its bands: the one band itself when it covers the
+// whole frame (one band, nothing cropped), so that the collector does not
+// hold the frame twice; else the bands pasted into a transparent frame.
+core::Image framePieces(decltype(NodeState::bands)& bands, int s, int width, int height) {
+  const core::PixelRect whole{0, 0, width, height};
+  for (auto& [key, band] : bands)
+    if (key.first == s && band.rect() == whole && band.frameWidth() == width && band.frameHeight() == height)
+      return std::move(band);
+  core::Image frame = core::Image::fullFrame(width, height);
+  for (const auto& [key, band] : bands)
+    if (key.first == s) paste(frame, band);
+  return frame;
+}
+
 }  // namespace
 
 void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFrame, bool coarse,
@@ -87,9 +101,7 @@ void collectWave(NodeState& state, std::uint32_t request, std::uint32_t lastFram
   try {
     for (std::size_t s = 0; s < slots; ++s) {
       const auto start = std::chrono::steady_clock::now();
-      core::Image frame = core::Image::fullFrame(width, height);
-      for (const auto& [key, band] : state.bands)
-        if (key.first == int(s)) paste(frame, band);
+      core::Image frame = framePieces(state.bands, int(s), width, height);
       const std::uint32_t number = state.wave[s].number;
       if (!state.dumpDir.empty()) dumpFloat(state.dumpDir, request, number, frame);
       proto::ImageFrame out;

@@ -20,12 +20,13 @@ void keepFirst(std::optional<comm::Failure>& first, const std::optional<comm::Fa
   if (next && !first) first = next;
 }
 
-// A finished band: kept if this is the collector, else sent to it.
-void deliver(NodeState& state, int slot, int band, const SubImage& message, double& comm,
+// A finished band: kept (moved, not copied) if this is the collector, else
+// sent to it.
+void deliver(NodeState& state, int slot, int band, SubImage&& message, double& comm,
              std::optional<comm::Failure>& failure) {
   if (state.world.rank() == 0) {
     keepFirst(failure, message.failure);
-    if (!message.failure) state.bands[{slot, band}] = message.image;
+    if (!message.failure) state.bands[{slot, band}] = std::move(message.image);
     return;
   }
   const auto t = Clock::now();
@@ -67,8 +68,8 @@ void compositeSelf(NodeState& state, int slot, WaveFrame& w, std::optional<comm:
   state.compositeLog.last = result.stats;
   if (cluster.rank() != 0) return;
   SubImage band{failure, {}};
-  if (!failure) band.image = cropToRect(result.image, bandRect(width, height, me.band, me.bands));
-  deliver(state, slot, me.band, band, w.comm, failure);
+  if (!failure) band.image = cropToRect(std::move(result.image), bandRect(width, height, me.band, me.bands));
+  deliver(state, slot, me.band, std::move(band), w.comm, failure);
 }
 
 // A coarse wave's small frame, in a cluster that composites itself: every
@@ -110,8 +111,8 @@ void compositeAtRoot(NodeState& state, int slot, WaveFrame& w, std::optional<com
     w.comp += secondsSince(t);
   }
   SubImage band{failure, {}};
-  if (!failure) band.image = cropToRect(acc, bandRect(width, height, me.band, me.bands));
-  deliver(state, slot, me.band, band, w.comm, failure);
+  if (!failure) band.image = cropToRect(std::move(acc), bandRect(width, height, me.band, me.bands));
+  deliver(state, slot, me.band, std::move(band), w.comm, failure);
 }
 
 void sendToCompositors(NodeState& state, WaveFrame& w, std::optional<comm::Failure>& failure) {
@@ -211,8 +212,8 @@ void compositeServed(NodeState& state, std::optional<comm::Failure>& rankFailure
     state.compositeLog.last = stats;
     if (j == 0) {
       SubImage band{failure, {}};
-      if (!failure) band.image = cropToRect(acc, bandRect(width, height, render.band, render.bands));
-      deliver(state, slot, render.band, band, w.comm, failure);
+      if (!failure) band.image = cropToRect(std::move(acc), bandRect(width, height, render.band, render.bands));
+      deliver(state, slot, render.band, std::move(band), w.comm, failure);
     }
     keepFirst(rankFailure, failure);
   }

@@ -25,8 +25,9 @@ core::CameraSpec cameraSpec(const CameraArgs& a) {
   return c;
 }
 
-core::Image cropToRect(const core::Image& image, const core::PixelRect& rect) {
+core::Image cropToRect(core::Image image, const core::PixelRect& rect) {
   const core::PixelRect r = image.rect().intersect(rect);
+  if (r == image.rect()) return image;
   core::Image out(image.frameWidth(), image.frameHeight(), r);
   for (int y = r.y0; y < r.y1; ++y)
     std::copy(&image.at(r.x0, y), &image.at(r.x0, y) + r.width(), out.row(y));

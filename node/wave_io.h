@@ -50,8 +50,10 @@ struct FrameView {
   static auto fields(auto& self) { return std::tie(self.number, self.camera, self.timestep); }
 };
 
-// The part of `image` inside `rect` (an image whose rect is the intersection).
-core::Image cropToRect(const core::Image& image, const core::PixelRect& rect);
+// The part of `image` inside `rect` (an image whose rect is the
+// intersection): `image` itself, moved, when it lies inside `rect` already,
+// so that the collector holds a frame once (issue 11: nothing kept twice).
+core::Image cropToRect(core::Image image, const core::PixelRect& rect);
 // acc = acc over back; acc grows to cover back's rect.
 void blendOver(core::Image& acc, const core::Image& back);
 // `part` written into `frame` (a full-frame image) at its rect.
