@@ -10,8 +10,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
-#include <vector>
 
 namespace pvr::core {
 
@@ -43,21 +41,17 @@ std::string boxText(const NodeBox& b) {
          std::to_string(b.hi.x) + "," + std::to_string(b.hi.y) + "," + std::to_string(b.hi.z);
 }
 
-// Appends the bytes of trivially copyable values; reads them back in order.
+// Writes the bytes of trivially copyable values straight to the file, and
+// reads them back in order: a summary's bounds (1/32 of an 8-bit brick's
+// bytes) never sit in memory twice (issue 11's bound on a rank's memory).
 struct Writer {
-  std::vector<char> out;
-  void bytes(const void* p, std::size_t n) { out.insert(out.end(), static_cast<const char*>(p), static_cast<const char*>(p) + n); }
+  std::ofstream& out;
+  void bytes(const void* p, std::size_t n) { out.write(static_cast<const char*>(p), std::streamsize(n)); }
   template <typename V> void value(const V& v) { bytes(&v, sizeof v); }
 };
 struct Reader {
-  const std::vector<char>& in;
-  std::size_t at = 0;
-  bool bytes(void* p, std::size_t n) {
-    if (n > in.size() - at) return false;
-    std::memcpy(p, in.data() + at, n);
-    at += n;
-    return true;
-  }
+  std::ifstream& in;
+  bool bytes(void* p, std::size_t n) { return bool(in.read(static_cast<char*>(p), std::streamsize(n))); }
   template <typename V> bool value(V& v) { return bytes(&v, sizeof v); }
 };
 
@@ -96,11 +90,10 @@ std::optional<Preprocessed> BrickSummaryCache::load() {
   std::error_code ec;
   if (std::filesystem::file_size(path_, ec) != expected || ec) return std::nullopt;
   std::ifstream in(path_, std::ios::binary);
-  std::vector<char> bytes(expected);
-  if (!in.read(bytes.data(), std::streamsize(expected))) return std::nullopt;
+  if (!in) return std::nullopt;
 
   // Step: magic, key and identity must match; then the payload.
-  Reader r{bytes};
+  Reader r{in};
   char magic[sizeof kMagic];
   std::uint32_t keyLength = 0;
   if (!r.bytes(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0) return std::nullopt;
@@ -131,26 +124,26 @@ void BrickSummaryCache::store(const Preprocessed& p) const {
   const double age = double(std::chrono::duration_cast<std::chrono::nanoseconds>(wall).count() - now->modifiedNs) / 1e9;
   if (age < kRacySeconds) return;
 
-  Writer w;
-  w.bytes(kMagic, sizeof kMagic);
-  w.value(std::uint32_t(key_.size()));
-  w.bytes(key_.data(), key_.size());
-  w.value(*now);
-  w.value(p.range.min);
-  w.value(p.range.max);
-  w.value(p.range.nonFinite);
-  const std::size_t half = p.bounds->byteSize() / 2;
-  w.bytes(p.bounds->min<std::byte>(), half);
-  w.bytes(p.bounds->max<std::byte>(), half);
-  w.bytes(p.histogram->counts.data(), p.histogram->counts.size() * sizeof(std::uint64_t));
-
   // Step: written beside, then renamed over: a reader sees a whole summary or none.
   std::error_code ec;
   std::filesystem::create_directories(std::filesystem::path(path_).parent_path(), ec);
   const std::string temporary = path_ + ".tmp." + std::to_string(::getpid());
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out.write(w.out.data(), std::streamsize(w.out.size()))) {
+    Writer w{out};
+    w.bytes(kMagic, sizeof kMagic);
+    w.value(std::uint32_t(key_.size()));
+    w.bytes(key_.data(), key_.size());
+    w.value(*now);
+    w.value(p.range.min);
+    w.value(p.range.max);
+    w.value(p.range.nonFinite);
+    const std::size_t half = p.bounds->byteSize() / 2;
+    w.bytes(p.bounds->min<std::byte>(), half);
+    w.bytes(p.bounds->max<std::byte>(), half);
+    w.bytes(p.histogram->counts.data(), p.histogram->counts.size() * sizeof(std::uint64_t));
+    out.close();  // a failed write or close leaves the stream failed
+    if (!out) {
       std::filesystem::remove(temporary, ec);
       return;
     }
