@@ -31,6 +31,11 @@
 
 namespace pvr::core::kernel {
 
+// No chunk follows on (runBatched).
+struct NoFollowOn {
+  std::int64_t operator()(std::int64_t at) const { return at; }
+};
+
 // Samples [start, exit) of a visible run, eight at a time while eight
 // remain; `start` advances past what was done, the caller takes the rest
 // one at a time. Plain (not pre-integrated) classification; needs voxel
@@ -41,9 +46,14 @@ namespace pvr::core::kernel {
 // into the ray (kernel_batch_over.h). Returns true when the ray reached the
 // early-termination opacity, tested after each batch. kPower: how shading
 // raises nh^shininess (specular_power.h).
-template <typename T, bool kShaded, int kPower = kTablePower>
+//
+// `more` (from runSpan, cast_ray.h) lets a walk's next chunk follow on: when
+// the whole batches end exactly at `exit`, more(exit) is where the batches
+// may go on to (exit itself: nowhere), and the loop goes on there as a new
+// call from `exit` would, with the same batches and so the same bits.
+template <typename T, bool kShaded, int kPower = kTablePower, typename More = NoFollowOn>
 inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
-                       std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
+                       std::int64_t exit, Accumulator& acc, std::uint64_t& samples, More&& more = More{}) {
   if (start + 8 > exit) return false;
   const T* v = static_cast<const T*>(p.voxels);
   const float o[3] = {float(ray.origin[0]), float(ray.origin[1]), float(ray.origin[2])};
@@ -104,6 +114,7 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
   Batch next = reconstruct(start);
   for (std::int64_t s = start; s + 8 <= exit; s += 8, start = s) {
     const Batch batch = next;
+    if (s + 8 == exit) exit = more(exit);
     if (s + 16 <= exit) next = reconstruct(s + 8);
     const __m256 value = batch.value;
     samples += 8;

@@ -11,15 +11,15 @@
 
 namespace pvr::core {
 
-// Skipping off (every macrocell visible).
+// Skipping off (every macrocell visible) unless `skip`.
 struct KernelFixture {
   MacrocellGrid macrocells;
   TransferTable table;
   std::vector<float> specular;
   KernelParams p;
-  KernelFixture(const Brick& volume, const TransferFunctionSpec& tf, const RenderOptions& o)
+  KernelFixture(const Brick& volume, const TransferFunctionSpec& tf, const RenderOptions& o, bool skip = false)
       : macrocells(volume), table(tf, o.step), specular(specularTable(o.shading.shininess)) {
-    macrocells.classify(table, false);
+    macrocells.classify(table, skip);
     setBrick(p, volume, macrocells);
     setTables(p, table, nullptr, o.step);
     setOptions(p, o, specular.data());
