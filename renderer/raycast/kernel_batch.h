@@ -342,7 +342,7 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
         continue;
       }
       if (frontStale) {
-        if constexpr (kRows) beforeRow = preint::rowEnd(p.preint, frontNode);
+        if constexpr (kRows) beforeRow = preint::frontRow(p.preint, frontNode);
         else preint::store(preint::endAt(p.preint, frontNode), before);
       }
       frontStale = false;
