@@ -311,10 +311,17 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   // The batches, with rows or cells (two loops, the choice made once).
   auto batches = [&](auto lookUp) __attribute__((always_inline)) -> bool {
     [[maybe_unused]] constexpr bool kRows = decltype(lookUp)::value;  // (AVX-512 only)
+    // The next batch's samples are fetched before this batch's empty test,
+    // as runBatched() does (a mispredicted skip then no longer discards the
+    // loads in flight); only when a next batch will run, and dropped when
+    // the ray terminates. aroundBatch() clamps its positions, so a batch
+    // past `exit` would read inside the stored box as well.
+    __m256 nextLo, nextHi;
+    __m256 nextAfter = aroundBatch(v, p, o, d, start + 2, nextLo, nextHi);
     for (std::int64_t s = start; s + kFullBatchesOnly < exit; s += 8) {
       // The samples at s + 2 .. s + 9 (after), and at s .. s + 7 and s + 1 .. s + 8.
-      __m256 lo8, hi8;
-      const __m256 after = aroundBatch(v, p, o, d, s + 2, lo8, hi8);
+      const __m256 after = nextAfter, lo8 = nextLo, hi8 = nextHi;
+      if (s + 8 + kFullBatchesOnly < exit) nextAfter = aroundBatch(v, p, o, d, s + 10, nextLo, nextHi);
       const __m256 before8 = shifted(carried, after, kTwo{}), at = shifted(carried, after, kOne{});
       const __m256 bend = _mm256_add_ps(_mm256_sub_ps(before8, _mm256_add_ps(at, at)), after);
       __m256 node = _mm256_sub_ps(at, _mm256_mul_ps(bend, _mm256_set1_ps(1.0f / 12.0f)));
@@ -346,7 +353,7 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
         continue;
       }
       if (frontStale) {
-        if constexpr (kRows) beforeRow = preint::rowEnd(p.preint, frontNode);
+        if constexpr (kRows) beforeRow = preint::frontRow(p.preint, frontNode);
         else preint::store(preint::endAt(p.preint, frontNode), before);
       }
       frontStale = false;

@@ -17,6 +17,7 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <type_traits>
 
@@ -408,6 +409,28 @@ inline RowEnd rowEnd(const PreintegralTables& t, float scalar) {
   const Coordinates8 c = coordinates(t, _mm256_set1_ps(scalar));
   const int cell = _mm256_cvtsi256_si32(c.cell);
   return {endRow(t.rows[cell], c.w, c.beyond), _mm512_cvtsd_f64(c.x)};
+}
+
+// rowEnd() of a batch's front, without the table where the transfer
+// function is empty around it: a front that allClear() would call clear
+// (below PreintegralTables::clearBelow, or at or above clearAbove, a cell
+// of margin for its coordinate's rounding) lies in a cell whose nodes
+// have no extinction or colour, where every row is the same, exactly:
+// all integrals 0 in the empty low end (the sums start at 0 and add
+// zeros), the integrals at the last node in the empty high end, and the
+// point values 0 (endRow()'s w and beyond terms then add exact zeros).
+// After a batch of empty segments, and at a run's start, the front is
+// mostly there; the table look-up it spares sat on the batch's chain of
+// dependent loads.
+inline RowEnd frontRow(const PreintegralTables& t, float scalar) {
+  const float at = std::fma(scalar, t.scale, t.offset);  // as allClear() computes it
+  if (at < t.clearBelow) {
+    return {_mm512_setzero_pd(), _mm512_cvtsd_f64(coordinates(t, _mm256_set1_ps(scalar)).x)};
+  }
+  if (at >= t.clearAbove) {
+    return {_mm512_load_pd(t.rows[t.entries - 1].value), _mm512_cvtsd_f64(coordinates(t, _mm256_set1_ps(scalar)).x)};
+  }
+  return rowEnd(t, scalar);
 }
 
 // The eight segments ending at these scalars, the first starting at

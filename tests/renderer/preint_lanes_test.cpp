@@ -28,6 +28,23 @@ TransferFunctionSpec mixedTransfer() {
   return tf;
 }
 
+// Transfer functions with empty ends: low and high, low only, high only
+// (index 2), low with gaps between visible ranges (index 3, mixedTransfer()),
+// and no visible range at all.
+std::vector<TransferFunctionSpec> emptyEndTransfers() {
+  auto ramp = [](std::vector<TransferPoint> points) {
+    TransferFunctionSpec tf;
+    tf.points = std::move(points);
+    tf.unitDistance = 1.0;
+    return tf;
+  };
+  return {ramp({{0.0, 0, 0, 0, 0}, {0.3, 0.1, 0.2, 0.9, 0}, {0.5, 1.0, 0.8, 0.3, 0.6}, {0.7, 0.2, 0.2, 0.2, 0}, {1.0, 0, 0, 0, 0}}),
+          ramp({{0.0, 0, 0, 0, 0}, {0.2, 0.1, 0.2, 0.9, 0}, {1.0, 0.9, 0.9, 0.9, 0.3}}),
+          ramp({{0.0, 0.5, 0.5, 0.5, 0.2}, {0.6, 0.1, 0.2, 0.9, 0}, {1.0, 0, 0, 0, 0}}),
+          mixedTransfer(),
+          ramp({{0.0, 0, 0, 0, 0}, {1.0, 1, 1, 1, 0}})};
+}
+
 }  // namespace
 
 #ifdef PVR_HAVE_PREINT_LANES
@@ -60,18 +77,7 @@ TEST_CASE("the lanes expm1 is the library expm1", "[preintegration]") {
 // rounding decides). Transfer functions: clear at both ends, clear low
 // end only, visible from the first node, with a gap, and all clear.
 TEST_CASE("a batch in the transfer function's empty ends is empty by either test", "[preintegration]") {
-  auto ramp = [](std::vector<TransferPoint> points) {
-    TransferFunctionSpec tf;
-    tf.points = std::move(points);
-    tf.unitDistance = 1.0;
-    return tf;
-  };
-  const TransferFunctionSpec tfs[] = {
-      ramp({{0.0, 0, 0, 0, 0}, {0.3, 0.1, 0.2, 0.9, 0}, {0.5, 1.0, 0.8, 0.3, 0.6}, {0.7, 0.2, 0.2, 0.2, 0}, {1.0, 0, 0, 0, 0}}),
-      ramp({{0.0, 0, 0, 0, 0}, {0.2, 0.1, 0.2, 0.9, 0}, {1.0, 0.9, 0.9, 0.9, 0.3}}),
-      ramp({{0.0, 0.5, 0.5, 0.5, 0.2}, {0.6, 0.1, 0.2, 0.9, 0}, {1.0, 0, 0, 0, 0}}),
-      mixedTransfer(),
-      ramp({{0.0, 0, 0, 0, 0}, {1.0, 1, 1, 1, 0}})};
+  const std::vector<TransferFunctionSpec> tfs = emptyEndTransfers();
   std::mt19937 random(7);
   for (int which = 0; which < int(std::size(tfs)); ++which) {
     const PreintegratedTable table(tfs[which]);
@@ -105,6 +111,48 @@ TEST_CASE("a batch in the transfer function's empty ends is empty by either test
     }
     INFO(clear << " batches clear by the ends, " << empty << " empty by the count");
     if (which != 2) CHECK(clear > 1000);
+  }
+}
+
+// Identity: frontRow() gives a front in the transfer function's empty ends
+// a constant row (all integrals 0 below, those at the last node above)
+// instead of the table's; it equals rowEnd() there exactly, and is
+// rowEnd() elsewhere. Scalars at the ends' limits, a rounding either side,
+// beyond the table and anywhere; a constant from the wrong node, or the
+// point values not 0, differs.
+TEST_CASE("a pre-integrated front in the empty ends takes a constant row equal to the table's", "[preintegration]") {
+  const std::vector<TransferFunctionSpec> tfs = emptyEndTransfers();
+  std::mt19937 random(11);
+  for (int which = 0; which < int(std::size(tfs)); ++which) {
+    const PreintegratedTable table(tfs[which]);
+    const PreintegralTables t = table.tables();
+    INFO("transfer function " << which << ", clear below " << t.clearBelow << ", at or above " << t.clearAbove);
+    std::vector<float> scalars;
+    for (float x : {t.clearBelow, t.clearAbove})
+      if (std::isfinite(x))
+        for (float dx : {-1.5f, -1.0f, -0.5f, -1e-3f, -1e-5f, 0.0f, 1e-5f, 1e-3f, 0.5f, 1.0f, 1.5f})
+          scalars.push_back((x + dx - t.offset) / t.scale);
+    std::uniform_real_distribution<float> anywhere(-0.3f, 1.3f);
+    for (int n = 0; n < 20000; ++n) scalars.push_back(anywhere(random));
+    int constant = 0, unequal = 0;
+    for (float scalar : scalars) {
+      const float at = std::fma(scalar, t.scale, t.offset);
+      constant += at < t.clearBelow || at >= t.clearAbove;
+      const preint::RowEnd a = preint::frontRow(t, scalar), b = preint::rowEnd(t, scalar);
+      alignas(64) double ra[8], rb[8];
+      _mm512_store_pd(ra, a.row);
+      _mm512_store_pd(rb, b.row);
+      bool same = a.x == b.x;
+      for (int k = 0; k < 8; ++k) same = same && ra[k] == rb[k];
+      if (!same) {
+        ++unequal;
+        UNSCOPED_INFO("scalar " << scalar << ": T " << ra[0] << " against " << rb[0] << ", tau " << ra[4]
+                                << " against " << rb[4] << ", x " << a.x << " against " << b.x);
+      }
+    }
+    INFO(constant << " of " << scalars.size() << " fronts in an empty end");
+    CHECK(unequal == 0);
+    if (which != 2) CHECK(constant > 1000);
   }
 }
 
