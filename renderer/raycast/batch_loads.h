@@ -144,10 +144,29 @@ template <typename T>
       q[n] = std::is_signed_v<T> ? _mm256_srai_epi32(_mm256_slli_epi32(byte, 24), 24) : byte;
     }
   } else {
+#if defined(__AVX512F__) && defined(__AVX512BW__)
+    // One gather of the eight 64-bit rows, then one word permute puts node
+    // n of every lane in words 8n .. 8n + 7, widened to 32 bits by halves.
+    // (Masked forms with every lane: the unmasked ones start from GCC 12's
+    // "undefined" vectors, which -Wmaybe-uninitialized reports.)
+    alignas(64) static constexpr std::int16_t kByNode[32] = {0, 4, 8,  12, 16, 20, 24, 28, 1, 5, 9,  13, 17, 21, 25, 29,
+                                                            2, 6, 10, 14, 18, 22, 26, 30, 3, 7, 11, 15, 19, 23, 27, 31};
+    const __m512i rows = _mm512_mask_i32gather_epi64(
+        _mm512_setzero_si512(), 0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)), b, sizeof(T));
+    const __m512i byNode = _mm512_maskz_permutexvar_epi16(~__mmask32(0), _mm512_load_si512(kByNode), rows);
+    const __m256i n01 = _mm512_maskz_extracti64x4_epi64(0xF, byNode, 0), n23 = _mm512_maskz_extracti64x4_epi64(0xF, byNode, 1);
+    const __m512i w01 = std::is_signed_v<T> ? _mm512_maskz_cvtepi16_epi32(0xFFFF, n01) : _mm512_maskz_cvtepu16_epi32(0xFFFF, n01);
+    const __m512i w23 = std::is_signed_v<T> ? _mm512_maskz_cvtepi16_epi32(0xFFFF, n23) : _mm512_maskz_cvtepu16_epi32(0xFFFF, n23);
+    q[0] = _mm512_maskz_extracti64x4_epi64(0xF, w01, 0);
+    q[1] = _mm512_maskz_extracti64x4_epi64(0xF, w01, 1);
+    q[2] = _mm512_maskz_extracti64x4_epi64(0xF, w23, 0);
+    q[3] = _mm512_maskz_extracti64x4_epi64(0xF, w23, 1);
+#else
     __m256 low, high;
     load64x8(b, index, low, high);
     splitPairsInt8<T>(_mm256_castps_si256(low), q[0], q[1]);
     splitPairsInt8<T>(_mm256_castps_si256(high), q[2], q[3]);
+#endif
   }
 }
 
