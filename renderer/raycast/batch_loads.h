@@ -104,6 +104,40 @@ template <typename T>
   }
 }
 
+// loadPairsExact8 at offset + h * step, h = 0 and 1, into lo[h], hi[h]; the
+// voxels at index[j] + offset + step + 1 must be stored too. Integer voxels
+// with AVX-512: one gather of sixteen words instead of two of eight.
+template <typename T>
+[[gnu::always_inline]] inline void loadPairsExact2x8(const T* v, const std::int32_t* index, std::int64_t offset,
+                                                     std::int32_t step, Exact8<T> lo[2], Exact8<T> hi[2]) {
+#if defined(__AVX512F__) && defined(__AVX512BW__)
+  if constexpr (!std::is_floating_point_v<T>) {
+    // Masked forms with every lane: the unmasked ones start from GCC 12's
+    // "undefined" vectors, which -Wmaybe-uninitialized reports.
+    constexpr int kBits = 8 * sizeof(T);
+    const __mmask16 all = 0xFFFF;
+    const __m256i at = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
+    const __m512i both = _mm512_maskz_inserti64x4(0xFF, _mm512_zextsi256_si512(at), _mm256_add_epi32(at, _mm256_set1_epi32(step)), 1);
+    const __m512i words = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), all, both, v + offset, sizeof(T));
+    __m512i first, second;
+    if constexpr (std::is_signed_v<T>) {
+      first = _mm512_maskz_srai_epi32(all, _mm512_maskz_slli_epi32(all, words, 32 - kBits), 32 - kBits);
+      second = _mm512_maskz_srai_epi32(all, _mm512_maskz_slli_epi32(all, words, 32 - 2 * kBits), 32 - kBits);
+    } else {
+      const __m512i mask = _mm512_set1_epi32((1 << kBits) - 1);
+      first = _mm512_maskz_and_epi32(all, words, mask);
+      second = _mm512_maskz_and_epi32(all, _mm512_maskz_srli_epi32(all, words, kBits), mask);
+    }
+    for (int h = 0; h < 2; ++h) {
+      lo[h] = _mm512_maskz_extracti64x4_epi64(0xF, first, h);
+      hi[h] = _mm512_maskz_extracti64x4_epi64(0xF, second, h);
+    }
+    return;
+  }
+#endif
+  for (int h = 0; h < 2; ++h) loadPairsExact8(v, index, offset + h * step, lo[h], hi[h]);
+}
+
 template <typename T>
 [[gnu::always_inline]] inline void loadPairs8(const T* v, const std::int32_t* index, std::int64_t offset,
                                               __m256& lo, __m256& hi) {
@@ -144,29 +178,10 @@ template <typename T>
       q[n] = std::is_signed_v<T> ? _mm256_srai_epi32(_mm256_slli_epi32(byte, 24), 24) : byte;
     }
   } else {
-#if defined(__AVX512F__) && defined(__AVX512BW__)
-    // One gather of the eight 64-bit rows, then one word permute puts node
-    // n of every lane in words 8n .. 8n + 7, widened to 32 bits by halves.
-    // (Masked forms with every lane: the unmasked ones start from GCC 12's
-    // "undefined" vectors, which -Wmaybe-uninitialized reports.)
-    alignas(64) static constexpr std::int16_t kByNode[32] = {0, 4, 8,  12, 16, 20, 24, 28, 1, 5, 9,  13, 17, 21, 25, 29,
-                                                            2, 6, 10, 14, 18, 22, 26, 30, 3, 7, 11, 15, 19, 23, 27, 31};
-    const __m512i rows = _mm512_mask_i32gather_epi64(
-        _mm512_setzero_si512(), 0xFF, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)), b, sizeof(T));
-    const __m512i byNode = _mm512_maskz_permutexvar_epi16(~__mmask32(0), _mm512_load_si512(kByNode), rows);
-    const __m256i n01 = _mm512_maskz_extracti64x4_epi64(0xF, byNode, 0), n23 = _mm512_maskz_extracti64x4_epi64(0xF, byNode, 1);
-    const __m512i w01 = std::is_signed_v<T> ? _mm512_maskz_cvtepi16_epi32(0xFFFF, n01) : _mm512_maskz_cvtepu16_epi32(0xFFFF, n01);
-    const __m512i w23 = std::is_signed_v<T> ? _mm512_maskz_cvtepi16_epi32(0xFFFF, n23) : _mm512_maskz_cvtepu16_epi32(0xFFFF, n23);
-    q[0] = _mm512_maskz_extracti64x4_epi64(0xF, w01, 0);
-    q[1] = _mm512_maskz_extracti64x4_epi64(0xF, w01, 1);
-    q[2] = _mm512_maskz_extracti64x4_epi64(0xF, w23, 0);
-    q[3] = _mm512_maskz_extracti64x4_epi64(0xF, w23, 1);
-#else
     __m256 low, high;
     load64x8(b, index, low, high);
     splitPairsInt8<T>(_mm256_castps_si256(low), q[0], q[1]);
     splitPairsInt8<T>(_mm256_castps_si256(high), q[2], q[3]);
-#endif
   }
 }
 
