@@ -110,31 +110,6 @@ template <typename T>
 template <typename T>
 [[gnu::always_inline]] inline void loadPairsExact2x8(const T* v, const std::int32_t* index, std::int64_t offset,
                                                      std::int32_t step, Exact8<T> lo[2], Exact8<T> hi[2]) {
-#if defined(__AVX512F__) && defined(__AVX512BW__)
-  if constexpr (!std::is_floating_point_v<T>) {
-    // Masked forms with every lane: the unmasked ones start from GCC 12's
-    // "undefined" vectors, which -Wmaybe-uninitialized reports.
-    constexpr int kBits = 8 * sizeof(T);
-    const __mmask16 all = 0xFFFF;
-    const __m256i at = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
-    const __m512i both = _mm512_maskz_inserti64x4(0xFF, _mm512_zextsi256_si512(at), _mm256_add_epi32(at, _mm256_set1_epi32(step)), 1);
-    const __m512i words = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), all, both, v + offset, sizeof(T));
-    __m512i first, second;
-    if constexpr (std::is_signed_v<T>) {
-      first = _mm512_maskz_srai_epi32(all, _mm512_maskz_slli_epi32(all, words, 32 - kBits), 32 - kBits);
-      second = _mm512_maskz_srai_epi32(all, _mm512_maskz_slli_epi32(all, words, 32 - 2 * kBits), 32 - kBits);
-    } else {
-      const __m512i mask = _mm512_set1_epi32((1 << kBits) - 1);
-      first = _mm512_maskz_and_epi32(all, words, mask);
-      second = _mm512_maskz_and_epi32(all, _mm512_maskz_srli_epi32(all, words, kBits), mask);
-    }
-    for (int h = 0; h < 2; ++h) {
-      lo[h] = _mm512_maskz_extracti64x4_epi64(0xF, first, h);
-      hi[h] = _mm512_maskz_extracti64x4_epi64(0xF, second, h);
-    }
-    return;
-  }
-#endif
   for (int h = 0; h < 2; ++h) loadPairsExact8(v, index, offset + h * step, lo[h], hi[h]);
 }
 
@@ -178,8 +153,13 @@ template <typename T>
       q[n] = std::is_signed_v<T> ? _mm256_srai_epi32(_mm256_slli_epi32(byte, 24), 24) : byte;
     }
   } else {
-    __m256 low, high;
-    load64x8(b, index, low, high);
+    // Two gathers of four 64-bit rows each (lanes 0-3, 4-7).
+    const __m256 front = _mm256_castsi256_ps(
+        _mm256_i32gather_epi64(reinterpret_cast<const long long*>(b), _mm_load_si128(reinterpret_cast<const __m128i*>(index)), sizeof(T)));
+    const __m256 back = _mm256_castsi256_ps(
+        _mm256_i32gather_epi64(reinterpret_cast<const long long*>(b), _mm_load_si128(reinterpret_cast<const __m128i*>(index + 4)), sizeof(T)));
+    const __m256 low = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0x88)), 0xD8));
+    const __m256 high = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0xDD)), 0xD8));
     splitPairsInt8<T>(_mm256_castps_si256(low), q[0], q[1]);
     splitPairsInt8<T>(_mm256_castps_si256(high), q[2], q[3]);
   }
