@@ -43,6 +43,15 @@ template <typename T>
   second = _mm256_cvtepi32_ps(b);
 }
 
+// Eight 64-bit words, lanes 0-3 in `front` and 4-7 in `back`, as two
+// vectors of 32-bit halves in lane order: `low` gets each lane's first
+// half, `high` its second.
+[[gnu::always_inline]] inline void halvesInLaneOrder(__m256 front, __m256 back, __m256& low, __m256& high) {
+  // Halves in lane order 0 1 4 5 | 2 3 6 7; the 64-bit permute puts them in order.
+  low = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0x88)), 0xD8));
+  high = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0xDD)), 0xD8));
+}
+
 // The 64 bits at b + index[j] of eight lanes, as two vectors of 32-bit
 // halves in lane order: `low` gets each lane's first half, `high` its second.
 template <typename T>
@@ -54,9 +63,7 @@ template <typename T>
   };
   const __m256 front = _mm256_castsi256_ps(_mm256_setr_epi64x(at(0), at(1), at(2), at(3)));  // lanes 0-3
   const __m256 back = _mm256_castsi256_ps(_mm256_setr_epi64x(at(4), at(5), at(6), at(7)));   // lanes 4-7
-  // Halves in lane order 0 1 4 5 | 2 3 6 7; the 64-bit permute puts them in order.
-  low = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0x88)), 0xD8));
-  high = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0xDD)), 0xD8));
+  halvesInLaneOrder(front, back, low, high);
 }
 
 // Voxels index[j] + offset and index[j] + offset + 1 of eight lanes.
@@ -104,20 +111,11 @@ template <typename T>
   }
 }
 
-// loadPairsExact8 at offset + h * step, h = 0 and 1, into lo[h], hi[h]; the
-// voxels at index[j] + offset + step + 1 must be stored too. Integer voxels
-// with AVX-512: one gather of sixteen words instead of two of eight.
-template <typename T>
-[[gnu::always_inline]] inline void loadPairsExact2x8(const T* v, const std::int32_t* index, std::int64_t offset,
-                                                     std::int32_t step, Exact8<T> lo[2], Exact8<T> hi[2]) {
-  for (int h = 0; h < 2; ++h) loadPairsExact8(v, index, offset + h * step, lo[h], hi[h]);
-}
-
 template <typename T>
 [[gnu::always_inline]] inline void loadPairs8(const T* v, const std::int32_t* index, std::int64_t offset,
                                               __m256& lo, __m256& hi) {
   if constexpr (std::is_floating_point_v<T>) {
-    load64x8(v + offset, index, lo, hi);
+    loadPairsExact8(v, index, offset, lo, hi);
   } else {
     loadPairs8(v, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)), offset, lo, hi);
   }
@@ -153,13 +151,16 @@ template <typename T>
       q[n] = std::is_signed_v<T> ? _mm256_srai_epi32(_mm256_slli_epi32(byte, 24), 24) : byte;
     }
   } else {
-    // Two gathers of four 64-bit rows each (lanes 0-3, 4-7).
-    const __m256 front = _mm256_castsi256_ps(
-        _mm256_i32gather_epi64(reinterpret_cast<const long long*>(b), _mm_load_si128(reinterpret_cast<const __m128i*>(index)), sizeof(T)));
-    const __m256 back = _mm256_castsi256_ps(
-        _mm256_i32gather_epi64(reinterpret_cast<const long long*>(b), _mm_load_si128(reinterpret_cast<const __m128i*>(index + 4)), sizeof(T)));
-    const __m256 low = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0x88)), 0xD8));
-    const __m256 high = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0xDD)), 0xD8));
+    // Two hardware gathers of four 64-bit rows each (lanes 0-3, 4-7): eight
+    // scalar loads moved into lanes by inserts (load64x8) took ~2 % more
+    // of the shaded CT head's frame (bench/results/shade.txt, session 10).
+    auto rows = [b, index](int first) __attribute__((always_inline)) {
+      return _mm256_castsi256_ps(_mm256_i32gather_epi64(
+          reinterpret_cast<const long long*>(b), _mm_loadu_si128(reinterpret_cast<const __m128i*>(index + first)),
+          sizeof(T)));
+    };
+    __m256 low, high;
+    halvesInLaneOrder(rows(0), rows(4), low, high);
     splitPairsInt8<T>(_mm256_castps_si256(low), q[0], q[1]);
     splitPairsInt8<T>(_mm256_castps_si256(high), q[2], q[3]);
   }

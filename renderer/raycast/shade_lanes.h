@@ -95,19 +95,11 @@ template <typename T>
     // Nodes y - 1 and y + 2 at dz = 0, 1, and z - 1 and z + 2 at dy = 0, 1
     // (pairs: dx = 0 and 1).
     Nodes ym[2][2], y2[2][2], zm[2][2], z2[2][2];
-    {
-      Nodes lo[2], hi[2];
-      auto pairs = [&](std::int64_t offset, std::int64_t step, Nodes out[2][2]) __attribute__((always_inline)) {
-        loadPairsExact2x8(v, index, offset, std::int32_t(step), lo, hi);
-        for (int h = 0; h < 2; ++h) {
-          out[h][0] = lo[h];
-          out[h][1] = hi[h];
-        }
-      };
-      pairs(-sy, sz, ym);
-      pairs(2 * sy, sz, y2);
-      pairs(-sz, sy, zm);
-      pairs(2 * sz, sy, z2);
+    for (int h = 0; h < 2; ++h) {
+      loadPairsExact8(v, index, -sy + h * sz, ym[h][0], ym[h][1]);
+      loadPairsExact8(v, index, 2 * sy + h * sz, y2[h][0], y2[h][1]);
+      loadPairsExact8(v, index, -sz + h * sy, zm[h][0], zm[h][1]);
+      loadPairsExact8(v, index, 2 * sz + h * sy, z2[h][0], z2[h][1]);
     }
     // The cell's corner (dx, dy, dz).
     auto corner = [&](int dx, int dy, int dz) __attribute__((always_inline)) {

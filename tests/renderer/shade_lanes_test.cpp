@@ -158,11 +158,11 @@ std::array<double, 8> lanesOf(kernel::Exact8<T> x) {
 }
 
 // Identity: the gradient's loads (batch_loads.h) give each lane's voxels
-// exactly, integers as 32-bit integers: the rows of four (loadQuads8) and
-// the pairs at two offsets a step apart (loadPairsExact2x8, one 16-lane
-// gather with AVX-512), at random indices, the type's extreme values
-// included; and the difference of two such integers converts to the float
-// that the difference of the two voxels as floats is.
+// exactly, integers as 32-bit integers: the rows of four (loadQuads8, by
+// 64-bit gathers for 16-bit voxels) and the pairs (loadPairsExact8), at
+// random indices, the type's extreme values included; and the difference
+// of two such integers converts to the float that the difference of the
+// two voxels as floats is.
 TEMPLATE_TEST_CASE("the gradient's loads give every voxel exactly", "[raycast]", std::uint8_t, std::int16_t,
                    std::uint16_t, float) {
   using T = TestType;
@@ -181,7 +181,7 @@ TEMPLATE_TEST_CASE("the gradient's loads give every voxel exactly", "[raycast]",
     const std::int64_t offset = round % 3;
     kernel::Exact8<T> q[4], first[2], second[2];
     kernel::loadQuads8(v.data(), index, offset, q);
-    kernel::loadPairsExact2x8(v.data(), index, offset, kStep, first, second);
+    for (int h = 0; h < 2; ++h) kernel::loadPairsExact8(v.data(), index, offset + h * kStep, first[h], second[h]);
     for (int n = 0; n < 4; ++n) {
       const std::array<double, 8> got = lanesOf<T>(q[n]);
       for (int j = 0; j < 8; ++j) REQUIRE(got[j] == double(v[index[j] + offset + n]));
