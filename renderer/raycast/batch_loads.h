@@ -43,15 +43,6 @@ template <typename T>
   second = _mm256_cvtepi32_ps(b);
 }
 
-// Eight 64-bit words, lanes 0-3 in `front` and 4-7 in `back`, as two
-// vectors of 32-bit halves in lane order: `low` gets each lane's first
-// half, `high` its second.
-[[gnu::always_inline]] inline void halvesInLaneOrder(__m256 front, __m256 back, __m256& low, __m256& high) {
-  // Halves in lane order 0 1 4 5 | 2 3 6 7; the 64-bit permute puts them in order.
-  low = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0x88)), 0xD8));
-  high = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0xDD)), 0xD8));
-}
-
 // The 64 bits at b + index[j] of eight lanes, as two vectors of 32-bit
 // halves in lane order: `low` gets each lane's first half, `high` its second.
 template <typename T>
@@ -63,7 +54,9 @@ template <typename T>
   };
   const __m256 front = _mm256_castsi256_ps(_mm256_setr_epi64x(at(0), at(1), at(2), at(3)));  // lanes 0-3
   const __m256 back = _mm256_castsi256_ps(_mm256_setr_epi64x(at(4), at(5), at(6), at(7)));   // lanes 4-7
-  halvesInLaneOrder(front, back, low, high);
+  // Halves in lane order 0 1 4 5 | 2 3 6 7; the 64-bit permute puts them in order.
+  low = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0x88)), 0xD8));
+  high = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0xDD)), 0xD8));
 }
 
 // Voxels index[j] + offset and index[j] + offset + 1 of eight lanes.
@@ -105,9 +98,8 @@ template <typename T>
   if constexpr (std::is_floating_point_v<T>) {
     load64x8(v + offset, index, lo, hi);
   } else {
-    const __m256i words = _mm256_i32gather_epi32(reinterpret_cast<const int*>(v + offset),
-                                                 _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)), sizeof(T));
-    splitPairsInt8<T>(words, lo, hi);
+    const __m256i at = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
+    splitPairsInt8<T>(_mm256_i32gather_epi32(reinterpret_cast<const int*>(v + offset), at, sizeof(T)), lo, hi);
   }
 }
 
@@ -151,16 +143,8 @@ template <typename T>
       q[n] = std::is_signed_v<T> ? _mm256_srai_epi32(_mm256_slli_epi32(byte, 24), 24) : byte;
     }
   } else {
-    // Two hardware gathers of four 64-bit rows each (lanes 0-3, 4-7): eight
-    // scalar loads moved into lanes by inserts (load64x8) took ~2 % more
-    // of the shaded CT head's frame (bench/results/shade.txt, session 10).
-    auto rows = [b, index](int first) __attribute__((always_inline)) {
-      return _mm256_castsi256_ps(_mm256_i32gather_epi64(
-          reinterpret_cast<const long long*>(b), _mm_loadu_si128(reinterpret_cast<const __m128i*>(index + first)),
-          sizeof(T)));
-    };
     __m256 low, high;
-    halvesInLaneOrder(rows(0), rows(4), low, high);
+    load64x8(b, index, low, high);
     splitPairsInt8<T>(_mm256_castps_si256(low), q[0], q[1]);
     splitPairsInt8<T>(_mm256_castps_si256(high), q[2], q[3]);
   }

@@ -158,8 +158,8 @@ std::array<double, 8> lanesOf(kernel::Exact8<T> x) {
 }
 
 // Identity: the gradient's loads (batch_loads.h) give each lane's voxels
-// exactly, integers as 32-bit integers: the rows of four (loadQuads8, by
-// 64-bit gathers for 16-bit voxels) and the pairs (loadPairsExact8), at
+// exactly, integers as 32-bit integers: the rows of four (loadQuads8) and
+// the pairs (loadPairsExact8), at
 // random indices, the type's extreme values included; and the difference
 // of two such integers converts to the float that the difference of the
 // two voxels as floats is.
