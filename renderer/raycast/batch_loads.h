@@ -20,27 +20,18 @@ inline __m256i clampCells8(__m256 u, int lo, int hi) {
 inline __m256 lerp8(__m256 a, __m256 b, __m256 w) { return _mm256_fmadd_ps(w, _mm256_sub_ps(b, a), a); }
 
 // Integer voxels packed two to a 32-bit lane (the first in the low bits)
-// as 32-bit integers: the first and the second of each lane.
-template <typename T>
-[[gnu::always_inline]] inline void splitPairsInt8(__m256i words, __m256i& first, __m256i& second) {
-  constexpr int kBits = 8 * sizeof(T);
-  if constexpr (std::is_signed_v<T>) {
-    first = _mm256_srai_epi32(_mm256_slli_epi32(words, 32 - kBits), 32 - kBits);
-    second = _mm256_srai_epi32(_mm256_slli_epi32(words, 32 - 2 * kBits), 32 - kBits);
-  } else {
-    const __m256i mask = _mm256_set1_epi32((1 << kBits) - 1);
-    first = _mm256_and_si256(words, mask);
-    second = _mm256_and_si256(_mm256_srli_epi32(words, kBits), mask);
-  }
-}
-
-// The same as floats.
+// as floats: the first and the second of each lane.
 template <typename T>
 [[gnu::always_inline]] inline void splitPairs8(__m256i words, __m256& first, __m256& second) {
-  __m256i a, b;
-  splitPairsInt8<T>(words, a, b);
-  first = _mm256_cvtepi32_ps(a);
-  second = _mm256_cvtepi32_ps(b);
+  constexpr int kBits = 8 * sizeof(T);
+  if constexpr (std::is_signed_v<T>) {
+    first = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(words, 32 - kBits), 32 - kBits));
+    second = _mm256_cvtepi32_ps(_mm256_srai_epi32(_mm256_slli_epi32(words, 32 - 2 * kBits), 32 - kBits));
+  } else {
+    const __m256i mask = _mm256_set1_epi32((1 << kBits) - 1);
+    first = _mm256_cvtepi32_ps(_mm256_and_si256(words, mask));
+    second = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(words, kBits), mask));
+  }
 }
 
 // The 64 bits at b + index[j] of eight lanes, as two vectors of 32-bit
@@ -76,48 +67,21 @@ template <typename T>
   splitPairs8<T>(words, lo, hi);
 }
 
-// Voxels as the gradient takes their differences (shade_lanes.h):
-// integers as 32-bit integers, where the difference of two is exact and
-// converts to the float that the difference of the two floats is (|a - b|
-// < 2^24 for 8- and 16-bit voxels); floats as floats.
-template <bool kFloat>
-struct ExactLanes {
-  using type = __m256i;
-};
-template <>
-struct ExactLanes<true> {
-  using type = __m256;
-};
-template <typename T>
-using Exact8 = typename ExactLanes<std::is_floating_point_v<T>>::type;
-
-// loadPairs8's voxels as Exact8<T>.
-template <typename T>
-[[gnu::always_inline]] inline void loadPairsExact8(const T* v, const std::int32_t* index, std::int64_t offset,
-                                                   Exact8<T>& lo, Exact8<T>& hi) {
-  if constexpr (std::is_floating_point_v<T>) {
-    load64x8(v + offset, index, lo, hi);
-  } else {
-    const __m256i at = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index));
-    splitPairsInt8<T>(_mm256_i32gather_epi32(reinterpret_cast<const int*>(v + offset), at, sizeof(T)), lo, hi);
-  }
-}
-
 template <typename T>
 [[gnu::always_inline]] inline void loadPairs8(const T* v, const std::int32_t* index, std::int64_t offset,
                                               __m256& lo, __m256& hi) {
   if constexpr (std::is_floating_point_v<T>) {
-    loadPairsExact8(v, index, offset, lo, hi);
+    load64x8(v + offset, index, lo, hi);
   } else {
     loadPairs8(v, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)), offset, lo, hi);
   }
 }
 
 // Voxels index[j] + offset + 0 .. 3 of eight lanes, one load per lane:
-// q[n] gets the voxels at + n, as Exact8<T>.
+// q[n] gets the voxels at + n.
 template <typename T>
 [[gnu::always_inline]] inline void loadQuads8(const T* v, const std::int32_t* index, std::int64_t offset,
-                                              Exact8<T> q[4]) {
+                                              __m256 q[4]) {
   const T* b = v + offset;
   if constexpr (std::is_floating_point_v<T>) {
     // Lanes j and j + 4 in one register, then a 4 x 4 transpose per half.
@@ -140,13 +104,13 @@ template <typename T>
     const __m256i mask = _mm256_set1_epi32(0xFF);
     for (int n = 0; n < 4; ++n) {
       const __m256i byte = n == 3 ? _mm256_srli_epi32(words, 24) : _mm256_and_si256(_mm256_srli_epi32(words, 8 * n), mask);
-      q[n] = std::is_signed_v<T> ? _mm256_srai_epi32(_mm256_slli_epi32(byte, 24), 24) : byte;
+      q[n] = _mm256_cvtepi32_ps(std::is_signed_v<T> ? _mm256_srai_epi32(_mm256_slli_epi32(byte, 24), 24) : byte);
     }
   } else {
     __m256 low, high;
     load64x8(b, index, low, high);
-    splitPairsInt8<T>(_mm256_castps_si256(low), q[0], q[1]);
-    splitPairsInt8<T>(_mm256_castps_si256(high), q[2], q[3]);
+    splitPairs8<T>(_mm256_castps_si256(low), q[0], q[1]);
+    splitPairs8<T>(_mm256_castps_si256(high), q[2], q[3]);
   }
 }
 

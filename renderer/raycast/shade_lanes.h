@@ -19,7 +19,6 @@
 
 #include <cfloat>
 #include <cstdint>
-#include <type_traits>
 
 #include "batch_loads.h"
 #include "kernel.h"
@@ -79,13 +78,9 @@ template <typename T>
     // Rows along x at (dy, dz) = (0,0), (1,0), (0,1), (1,1): nodes x - 1 ..
     // x + 2; x0 and x1 are the cell's own corners, which the y and z
     // differences reuse.
-    // Nodes as Exact8<T> (batch_loads.h): the differences of integer
-    // voxels are taken in integers and converted once, 24 conversions a
-    // lane instead of 32, to the same floats.
-    using Nodes = Exact8<T>;
-    Nodes xm[4], x0[4], x1[4], x2[4];
+    __m256 xm[4], x0[4], x1[4], x2[4];
     for (int r = 0; r < 4; ++r) {
-      Nodes q[4];
+      __m256 q[4];
       loadQuads8(v, index, (r & 1) * sy + (r >> 1) * sz - 1, q);
       xm[r] = q[0];
       x0[r] = q[1];
@@ -94,12 +89,12 @@ template <typename T>
     }
     // Nodes y - 1 and y + 2 at dz = 0, 1, and z - 1 and z + 2 at dy = 0, 1
     // (pairs: dx = 0 and 1).
-    Nodes ym[2][2], y2[2][2], zm[2][2], z2[2][2];
+    __m256 ym[2][2], y2[2][2], zm[2][2], z2[2][2];
     for (int h = 0; h < 2; ++h) {
-      loadPairsExact8(v, index, -sy + h * sz, ym[h][0], ym[h][1]);
-      loadPairsExact8(v, index, 2 * sy + h * sz, y2[h][0], y2[h][1]);
-      loadPairsExact8(v, index, -sz + h * sy, zm[h][0], zm[h][1]);
-      loadPairsExact8(v, index, 2 * sz + h * sy, z2[h][0], z2[h][1]);
+      loadPairs8(v, index, -sy + h * sz, ym[h][0], ym[h][1]);
+      loadPairs8(v, index, 2 * sy + h * sz, y2[h][0], y2[h][1]);
+      loadPairs8(v, index, -sz + h * sy, zm[h][0], zm[h][1]);
+      loadPairs8(v, index, 2 * sz + h * sy, z2[h][0], z2[h][1]);
     }
     // The cell's corner (dx, dy, dz).
     auto corner = [&](int dx, int dy, int dz) __attribute__((always_inline)) {
@@ -107,17 +102,10 @@ template <typename T>
     };
     // (1 - f) (after - before) + f (far - near): a central difference at
     // the two nodes either side, interpolated (interiorGradient()).
-    auto minus = [](Nodes a, Nodes b) __attribute__((always_inline)) {
-      if constexpr (std::is_floating_point_v<T>) {
-        return _mm256_sub_ps(a, b);
-      } else {
-        return _mm256_cvtepi32_ps(_mm256_sub_epi32(a, b));
-      }
-    };
-    auto difference = [&](__m256 f, Nodes before, Nodes near, Nodes after, Nodes far)
+    auto difference = [](__m256 f, __m256 before, __m256 near, __m256 after, __m256 far)
                           __attribute__((always_inline)) {
-      return _mm256_fmadd_ps(f, minus(far, near),
-                             _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(1.0f), f), minus(after, before)));
+      return _mm256_fmadd_ps(f, _mm256_sub_ps(far, near),
+                             _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(1.0f), f), _mm256_sub_ps(after, before)));
     };
     auto bilinear = [](__m256 w1, __m256 w2, __m256 a00, __m256 a10, __m256 a01, __m256 a11)
                         __attribute__((always_inline)) { return lerp8(lerp8(a00, a10, w1), lerp8(a01, a11, w1), w2); };

@@ -4,7 +4,6 @@
 #include <catch2/catch.hpp>
 
 #include <array>
-#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -139,70 +138,6 @@ TEST_CASE("the vector gradient equals the scalar gradient", "[raycast]") {
       if (type == ScalarType::kFloat32) CHECK(nonFinite > 10);
     }
   }
-}
-
-// The eight lanes of an Exact8<T> (batch_loads.h) as doubles.
-template <typename T>
-std::array<double, 8> lanesOf(kernel::Exact8<T> x) {
-  std::array<double, 8> out;
-  if constexpr (std::is_floating_point_v<T>) {
-    alignas(32) float f[8];
-    _mm256_store_ps(f, x);
-    for (int j = 0; j < 8; ++j) out[j] = f[j];
-  } else {
-    alignas(32) std::int32_t i[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(i), x);
-    for (int j = 0; j < 8; ++j) out[j] = i[j];
-  }
-  return out;
-}
-
-// Identity: the gradient's loads (batch_loads.h) give each lane's voxels
-// exactly, integers as 32-bit integers: the rows of four (loadQuads8) and
-// the pairs (loadPairsExact8), at
-// random indices, the type's extreme values included; and the difference
-// of two such integers converts to the float that the difference of the
-// two voxels as floats is.
-TEMPLATE_TEST_CASE("the gradient's loads give every voxel exactly", "[raycast]", std::uint8_t, std::int16_t,
-                   std::uint16_t, float) {
-  using T = TestType;
-  std::mt19937 random(13);
-  constexpr int kVoxels = 4096, kStep = 700;
-  std::vector<T> v(kVoxels + 8);
-  const double lo = std::is_floating_point_v<T> ? -1e6 : double(std::numeric_limits<T>::lowest());
-  const double hi = std::is_floating_point_v<T> ? 1e6 : double(std::numeric_limits<T>::max());
-  std::uniform_real_distribution<double> value(lo, hi);
-  for (std::size_t n = 0; n < v.size(); ++n) v[n] = T(n % 5 == 0 ? lo : n % 5 == 1 ? hi : value(random));
-  std::uniform_int_distribution<std::int32_t> at(0, kVoxels - kStep - 4);
-  int compared = 0;
-  for (int round = 0; round < 500; ++round) {
-    alignas(32) std::int32_t index[8];
-    for (int j = 0; j < 8; ++j) index[j] = at(random);
-    const std::int64_t offset = round % 3;
-    kernel::Exact8<T> q[4], first[2], second[2];
-    kernel::loadQuads8(v.data(), index, offset, q);
-    for (int h = 0; h < 2; ++h) kernel::loadPairsExact8(v.data(), index, offset + h * kStep, first[h], second[h]);
-    for (int n = 0; n < 4; ++n) {
-      const std::array<double, 8> got = lanesOf<T>(q[n]);
-      for (int j = 0; j < 8; ++j) REQUIRE(got[j] == double(v[index[j] + offset + n]));
-    }
-    for (int h = 0; h < 2; ++h) {
-      const std::array<double, 8> a = lanesOf<T>(first[h]), b = lanesOf<T>(second[h]);
-      for (int j = 0; j < 8; ++j) {
-        INFO("lane " << j << " index " << index[j] << " offset " << offset << " h " << h);
-        REQUIRE(a[j] == double(v[index[j] + offset + h * kStep]));
-        REQUIRE(b[j] == double(v[index[j] + offset + h * kStep + 1]));
-        compared += 2;
-      }
-    }
-    if constexpr (!std::is_floating_point_v<T>) {
-      alignas(32) float d[8];
-      _mm256_store_ps(d, _mm256_cvtepi32_ps(_mm256_sub_epi32(q[3], first[1])));
-      for (int j = 0; j < 8; ++j)
-        REQUIRE(d[j] == float(v[index[j] + offset + 3]) - float(v[index[j] + offset + kStep]));
-    }
-  }
-  CHECK(compared == 500 * 32);
 }
 
 // Identity: shadeQuads() lights each sample of opacity > 0 as
