@@ -65,8 +65,7 @@ std::vector<double> frameTimes(const std::vector<comm::Bytes>& perRank, std::siz
 core::Image framePieces(decltype(NodeState::bands)& bands, int s, int width, int height) {
   const core::PixelRect whole{0, 0, width, height};
   for (auto& [key, band] : bands)
-    if (key.first == s && band.rect() == whole && band.frameWidth() == width && band.frameHeight() == height)
-      return std::move(band);
+    if (key.first == s && band.rect() == whole) return std::move(band);
   core::Image frame = core::Image::fullFrame(width, height);
   for (const auto& [key, band] : bands)
     if (key.first == s) paste(frame, band);

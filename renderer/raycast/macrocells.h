@@ -71,8 +71,9 @@ class MacrocellGrid {
   LeapFields leapFields(const std::vector<int>& wanted, ThreadPool* pool = nullptr) const;
   // How many forward fields are kept at most: a byte per macrocell each,
   // together at most 1/64 of the brick's voxel bytes (issue 11 allows a
-  // rank 1.1x its share of the volume, and it uses about 1.08x): one for
-  // 8-bit data (a macrocell holds 64 voxels), two for 16-bit, four beyond.
+  // rank 1.1x its share of the volume; with the field a 2048^3 rank peaks
+  // at 1.09-1.10x, bench/results/scale): one for 8-bit data (a macrocell
+  // holds 64 voxels), two for 16-bit, four beyond.
   int forwardFieldsKept() const;
 
  private:

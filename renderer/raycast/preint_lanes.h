@@ -424,13 +424,10 @@ inline RowEnd rowEnd(const PreintegralTables& t, float scalar) {
 // dependent loads.
 inline RowEnd frontRow(const PreintegralTables& t, float scalar) {
   const float at = std::fma(scalar, t.scale, t.offset);  // as allClear() computes it
-  if (at < t.clearBelow) {
-    return {_mm512_setzero_pd(), _mm512_cvtsd_f64(coordinates(t, _mm256_set1_ps(scalar)).x)};
-  }
-  if (at >= t.clearAbove) {
-    return {_mm512_load_pd(t.rows[t.entries - 1].value), _mm512_cvtsd_f64(coordinates(t, _mm256_set1_ps(scalar)).x)};
-  }
-  return rowEnd(t, scalar);
+  const bool low = at < t.clearBelow, high = at >= t.clearAbove;  // neither for NaN
+  if (!low && !high) return rowEnd(t, scalar);
+  const __m512d row = low ? _mm512_setzero_pd() : _mm512_load_pd(t.rows[t.entries - 1].value);
+  return {row, _mm512_cvtsd_f64(coordinates(t, _mm256_set1_ps(scalar)).x)};
 }
 
 // The eight segments ending at these scalars, the first starting at
