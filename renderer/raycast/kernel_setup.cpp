@@ -137,7 +137,7 @@ std::vector<float> specularTable(double shininess) {
   return table;
 }
 
-RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step, const Vec3& lightWorld) {
+RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step) {
   RaySetup s;
   for (int a = 0; a < 3; ++a) {
     s.origin[a] = (ray.origin[a] - grid.origin[a]) / grid.spacing[a];
@@ -146,6 +146,11 @@ RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step, const V
   }
   const double major = std::max({std::abs(s.step[0]), std::abs(s.step[1]), std::abs(s.step[2])});
   s.leapPerMacrocell = double(MacrocellGrid::kSize) / major;
+  return s;
+}
+
+RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step, const Vec3& lightWorld) {
+  RaySetup s = raySetup(ray, grid, step);
   // Headlight by default: the light direction is fixed in camera space.
   // The viewer looks back along the ray.
   const Vec3 view = -ray.direction;
