@@ -79,8 +79,8 @@ struct RaySetup {
   double step[3];
   double invStep[3];  // 1 / step (0 where step is 0): macrocell exits without division
   double leapPerMacrocell;  // samples per macrocell edge along the ray's major axis
-  float light[3] = {0, 0, 0};    // unit vector towards the light, world space (shaded rays)
-  float halfway[3] = {0, 0, 0};  // Blinn-Phong half vector, world space (shaded rays)
+  float light[3];     // unit vector towards the light, world space
+  float halfway[3];   // Blinn-Phong half vector, world space
 };
 
 // Rays a caster takes at once, neighbours along a row (castRays in

@@ -138,7 +138,7 @@ std::vector<float> specularTable(double shininess) {
 }
 
 RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step) {
-  RaySetup s;
+  RaySetup s{};  // the lighting vectors zero
   for (int a = 0; a < 3; ++a) {
     s.origin[a] = (ray.origin[a] - grid.origin[a]) / grid.spacing[a];
     s.step[a] = ray.direction[a] * step / grid.spacing[a];
