@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <cstring>
 #include <type_traits>
+#include <utility>
 
 #include "kernel.h"
 #include "preint_lanes.h"
@@ -51,9 +52,12 @@ struct NoFollowOn {
 // the whole batches end exactly at `exit`, more(exit) is where the batches
 // may go on to (exit itself: nowhere), and the loop goes on there as a new
 // call from `exit` would, with the same batches and so the same bits.
-template <typename T, bool kShaded, int kPower = kTablePower, typename More = NoFollowOn>
-inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
-                       std::int64_t exit, Accumulator& acc, std::uint64_t& samples, More&& more = More{}) {
+//
+// kShifted: voxel indices by shifts (KernelParams::strideShift, voxelIndex8);
+// runBatched picks it per call.
+template <typename T, bool kShaded, int kPower, bool kShifted, typename More>
+inline bool runBatchedIndexed(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
+                              std::int64_t exit, Accumulator& acc, std::uint64_t& samples, More&& more) {
   if (start + 8 > exit) return false;
   const T* v = static_cast<const T*>(p.voxels);
   const float o[3] = {float(ray.origin[0]), float(ray.origin[1]), float(ray.origin[2])};
@@ -61,8 +65,8 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
   const __m256 o0 = _mm256_set1_ps(o[0]), o1 = _mm256_set1_ps(o[1]), o2 = _mm256_set1_ps(o[2]);
   const __m256 d0 = _mm256_set1_ps(d[0]), d1 = _mm256_set1_ps(d[1]), d2 = _mm256_set1_ps(d[2]);
   const __m256 lanes = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256i strideY = _mm256_set1_epi32(std::int32_t(p.strideY));
-  const __m256i strideZ = _mm256_set1_epi32(std::int32_t(p.strideZ));
+  const __m256i byY = _mm256_set1_epi32(std::int32_t(kShifted ? p.strideShift[0] : p.strideY));
+  const __m256i byZ = _mm256_set1_epi32(std::int32_t(kShifted ? p.strideShift[1] : p.strideZ));
   const __m256i base = _mm256_set1_epi32(std::int32_t(p.base));
   const __m256 scale = _mm256_set1_ps(p.tableScale), offset = _mm256_set1_ps(p.tableOffset);
   const __m256 tableLast = _mm256_set1_ps(float(p.tableEntries - 1));
@@ -89,10 +93,7 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
     const __m256 fy = _mm256_sub_ps(u1, _mm256_cvtepi32_ps(j));
     const __m256 fz = _mm256_sub_ps(u2, _mm256_cvtepi32_ps(kk));
     alignas(32) std::int32_t index[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(index),
-                       _mm256_add_epi32(_mm256_add_epi32(i, base),
-                                        _mm256_add_epi32(_mm256_mullo_epi32(j, strideY),
-                                                         _mm256_mullo_epi32(kk, strideZ))));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(index), voxelIndex8<kShifted>(i, j, kk, base, byY, byZ));
     // Trilinear reconstruction.
     __m256 a0, a1, b0, b1, c0, c1, e0, e1;
     loadPairs8(v, index, 0, a0, a1);
@@ -136,7 +137,7 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
     if constexpr (std::is_floating_point_v<T>) keepQuads(c, finite);
     if constexpr (kShaded) {
       // Light the visible samples, all eight lanes at once (shade_lanes.h).
-      shadeQuads<T, kPower>(v, p, ray, batch.u, c);
+      shadeQuads<T, kPower, kShifted>(v, p, ray, batch.u, c);
     }
     // Composite the batch, then the batch into the ray.
     gathered = addBehind4(gathered, overQuads(c));
@@ -153,6 +154,14 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
   acc.b = out[2];
   acc.a = out[3];
   return terminated;
+}
+
+template <typename T, bool kShaded, int kPower = kTablePower, typename More = NoFollowOn>
+inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t& start, std::int64_t exit,
+                       Accumulator& acc, std::uint64_t& samples, More&& more = More{}) {
+  if (p.strideShift[0] >= 0)
+    return runBatchedIndexed<T, kShaded, kPower, true>(p, ray, start, exit, acc, samples, std::forward<More>(more));
+  return runBatchedIndexed<T, kShaded, kPower, false>(p, ray, start, exit, acc, samples, std::forward<More>(more));
 }
 
 // The scalars at samples [first, first + 8) as `around` reads them
@@ -174,9 +183,9 @@ template <typename T>
   }
   alignas(32) std::int32_t index[8];
   _mm256_store_si256(reinterpret_cast<__m256i*>(index),
-                     _mm256_add_epi32(_mm256_add_epi32(cell[0], _mm256_set1_epi32(std::int32_t(p.base))),
-                                      _mm256_add_epi32(_mm256_mullo_epi32(cell[1], _mm256_set1_epi32(std::int32_t(p.strideY))),
-                                                       _mm256_mullo_epi32(cell[2], _mm256_set1_epi32(std::int32_t(p.strideZ))))));
+                     voxelIndex8<false>(cell[0], cell[1], cell[2], _mm256_set1_epi32(std::int32_t(p.base)),
+                                        _mm256_set1_epi32(std::int32_t(p.strideY)),
+                                        _mm256_set1_epi32(std::int32_t(p.strideZ))));
   __m256 a0, a1, b0, b1, c0, c1, e0, e1;
   loadPairs8(v, index, 0, a0, a1);
   loadPairs8(v, index, p.strideY, b0, b1);

@@ -15,6 +15,10 @@ void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocel
   p.strideY = ext.x;
   p.strideZ = ext.x * ext.y;
   p.base = -(st.lo.x + st.lo.y * p.strideY + st.lo.z * p.strideZ);
+  const auto log2Exact = [](std::int64_t n) { return n > 0 && (n & (n - 1)) == 0 ? __builtin_ctzll(n) : -1; };
+  const int shiftY = log2Exact(p.strideY), shiftZ = log2Exact(p.strideZ);
+  p.strideShift[0] = shiftY >= 0 && shiftZ >= 0 ? shiftY : -1;
+  p.strideShift[1] = shiftY >= 0 && shiftZ >= 0 ? shiftZ : -1;
   p.indices32 = st.nodeCount() < (std::int64_t(1) << 31) - 1;
   for (int a = 0; a < 3; ++a) {
     p.ownLo[a] = double(own.lo[a]);
