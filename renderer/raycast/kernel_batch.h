@@ -65,9 +65,7 @@ inline bool runBatchedIndexed(const KernelParams& p, const RaySetup& ray, std::i
   const __m256 o0 = _mm256_set1_ps(o[0]), o1 = _mm256_set1_ps(o[1]), o2 = _mm256_set1_ps(o[2]);
   const __m256 d0 = _mm256_set1_ps(d[0]), d1 = _mm256_set1_ps(d[1]), d2 = _mm256_set1_ps(d[2]);
   const __m256 lanes = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256i byY = _mm256_set1_epi32(std::int32_t(kShifted ? p.strideShift[0] : p.strideY));
-  const __m256i byZ = _mm256_set1_epi32(std::int32_t(kShifted ? p.strideShift[1] : p.strideZ));
-  const __m256i base = _mm256_set1_epi32(std::int32_t(p.base));
+  const IndexLanes<kShifted> indexing(p);
   const __m256 scale = _mm256_set1_ps(p.tableScale), offset = _mm256_set1_ps(p.tableOffset);
   const __m256 tableLast = _mm256_set1_ps(float(p.tableEntries - 1));
   const __m256i entryLast = _mm256_set1_epi32(p.tableEntries - 2);
@@ -93,7 +91,7 @@ inline bool runBatchedIndexed(const KernelParams& p, const RaySetup& ray, std::i
     const __m256 fy = _mm256_sub_ps(u1, _mm256_cvtepi32_ps(j));
     const __m256 fz = _mm256_sub_ps(u2, _mm256_cvtepi32_ps(kk));
     alignas(32) std::int32_t index[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(index), voxelIndex8<kShifted>(i, j, kk, base, byY, byZ));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(index), voxelIndex8(indexing, i, j, kk));
     // Trilinear reconstruction.
     __m256 a0, a1, b0, b1, c0, c1, e0, e1;
     loadPairs8(v, index, 0, a0, a1);
@@ -183,9 +181,7 @@ template <typename T, bool kShifted = false>
   }
   alignas(32) std::int32_t index[8];
   _mm256_store_si256(reinterpret_cast<__m256i*>(index),
-                     voxelIndex8<kShifted>(cell[0], cell[1], cell[2], _mm256_set1_epi32(std::int32_t(p.base)),
-                                           _mm256_set1_epi32(std::int32_t(kShifted ? p.strideShift[0] : p.strideY)),
-                                           _mm256_set1_epi32(std::int32_t(kShifted ? p.strideShift[1] : p.strideZ))));
+                     voxelIndex8(IndexLanes<kShifted>(p), cell[0], cell[1], cell[2]));
   __m256 a0, a1, b0, b1, c0, c1, e0, e1;
   loadPairs8(v, index, 0, a0, a1);
   loadPairs8(v, index, p.strideY, b0, b1);

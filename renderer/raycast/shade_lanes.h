@@ -63,10 +63,7 @@ template <typename T, bool kShifted = false>
   if (interior) {
     // Lanes not computed here read around the first lane that is, so every
     // load stays in the stored box.
-    const __m256i index0 = voxelIndex8<kShifted>(
-        cell[0], cell[1], cell[2], _mm256_set1_epi32(std::int32_t(p.base)),
-        _mm256_set1_epi32(std::int32_t(kShifted ? p.strideShift[0] : p.strideY)),
-        _mm256_set1_epi32(std::int32_t(kShifted ? p.strideShift[1] : p.strideZ)));
+    const __m256i index0 = voxelIndex8(IndexLanes<kShifted>(p), cell[0], cell[1], cell[2]);
     const __m256i firstLane =
         _mm256_permutevar8x32_epi32(index0, _mm256_set1_epi32(__builtin_ctz(interior)));
     alignas(32) std::int32_t index[8];
