@@ -178,6 +178,9 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
       }
     }
 #endif
+    // What no batch kernel took: the whole run without one (no AVX2, or
+    // indices past 32 bits), the pre-integrated run's last 1 to 7 segments
+    // without AVX-512; runBatched takes its run's tail itself.
     if (runScalar<T, kShaded, kPreintegrated, kPower>(p, ray, start, body, acc, samples)) return true;
     start = body;
   }
