@@ -40,11 +40,11 @@ struct NoFollowOn {
 // as one batch with the lanes past `exit` masked out; `start` advances past
 // what was done (to `exit` unless the ray terminated). Plain (not
 // pre-integrated) classification; needs voxel indices that fit 32 bits
-// (KernelParams::indices32). A batch whose eight
-// table coordinates all lie in the transfer function's transparent ends
-// (KernelParams::clearBelow, clearAbove) stops after the reconstruction;
-// the others are classified and composited with each other first, then
-// into the ray (kernel_batch_over.h). Returns true when the ray reached the
+// (KernelParams::indices32). A batch whose eight table coordinates all lie
+// in the transfer function's transparent ends (KernelParams::clearBelow,
+// clearAbove) stops after the reconstruction; the others are classified
+// and composited with each other first, then into the ray
+// (kernel_batch_over.h). Returns true when the ray reached the
 // early-termination opacity, tested after each batch. kPower: how shading
 // raises nh^shininess (specular_power.h).
 //
@@ -163,7 +163,8 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
   // The run's last 1 to 7 samples, as one more batch with the lanes past
   // the run masked out. One at a time (runScalar), each visible sample lit
   // by the scalar gradient, they took 2.6 % of a shaded CT head frame for
-  // 1.2 % of its samples (bench/results/shade.txt, session 11). Composited
+  // 1.2 % of its samples; as a batch, the frame takes 1.5-2 % less CPU
+  // (unshaded ~3 %; bench/results/shade.txt, session 11). Composited
   // in float like any batch: within a few ulp of the batch's colour of the
   // scalar loop's double "over" (kernel_batch_over.h), and early
   // termination is tested after it, as after every batch.
