@@ -37,14 +37,15 @@ struct NoFollowOn {
   std::int64_t operator()(std::int64_t at) const { return at; }
 };
 
-// Samples [start, exit) of a visible run, eight at a time while eight
-// remain; `start` advances past what was done, the caller takes the rest
-// one at a time. Plain (not pre-integrated) classification; needs voxel
-// indices that fit 32 bits (KernelParams::indices32). A batch whose eight
-// table coordinates all lie in the transfer function's transparent ends
-// (KernelParams::clearBelow, clearAbove) stops after the reconstruction;
-// the others are classified and composited with each other first, then
-// into the ray (kernel_batch_over.h). Returns true when the ray reached the
+// Samples [start, exit) of a visible run, eight at a time, the last 1 to 7
+// as one batch with the lanes past `exit` masked out; `start` advances past
+// what was done (to `exit` unless the ray terminated). Plain (not
+// pre-integrated) classification; needs voxel indices that fit 32 bits
+// (KernelParams::indices32). A batch whose eight table coordinates all lie
+// in the transfer function's transparent ends (KernelParams::clearBelow,
+// clearAbove) stops after the reconstruction; the others are classified
+// and composited with each other first, then into the ray
+// (kernel_batch_over.h). Returns true when the ray reached the
 // early-termination opacity, tested after each batch. kPower: how shading
 // raises nh^shininess (specular_power.h).
 //
@@ -58,7 +59,7 @@ struct NoFollowOn {
 template <typename T, bool kShaded, int kPower, bool kShifted, typename More>
 inline bool runBatchedIndexed(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
                               std::int64_t exit, Accumulator& acc, std::uint64_t& samples, More&& more) {
-  if (start + 8 > exit) return false;
+  if (start >= exit) return false;
   const T* v = static_cast<const T*>(p.voxels);
   const float o[3] = {float(ray.origin[0]), float(ray.origin[1]), float(ray.origin[2])};
   const float d[3] = {float(ray.step[0]), float(ray.step[1]), float(ray.step[2])};
@@ -105,45 +106,72 @@ inline bool runBatchedIndexed(const KernelParams& p, const RaySetup& ray, std::i
     out.u[2] = u2;
     return out;
   };
-  // The next batch's voxels are fetched before this batch's transparency
-  // test: a mispredicted skip then no longer discards the fetch in flight
-  // (peer scene: 15 % less CPU time, bench/results/plain.txt). Fetched only
-  // while eight more samples remain, so nothing past the run is read; the
-  // batch fetched ahead of one that terminates the ray is dropped.
-  Batch next = reconstruct(start);
-  for (std::int64_t s = start; s + 8 <= exit; s += 8, start = s) {
-    const Batch batch = next;
-    if (s + 8 == exit) exit = more(exit);
-    if (s + 16 <= exit) next = reconstruct(s + 8);
+  // Classify, light and composite one batch into `gathered`; true when the
+  // ray reached the early-termination opacity. A tail batch (kTail) keeps
+  // only the lanes in `inRun`: the others lie past the run, their
+  // positions' cells clamped into the owned box as every lane's are (so
+  // their reads stay in bounds), and are made transparent as non-finite
+  // values are, before lighting (which lights only lanes with opacity).
+  auto take = [&](const Batch& batch, auto kTail, [[maybe_unused]] __m256 inRun)
+                  __attribute__((always_inline)) -> bool {
     const __m256 value = batch.value;
-    samples += 8;
     // Table coordinates (a NaN becomes 0: max returns its second operand).
     const __m256 x = _mm256_min_ps(
         _mm256_max_ps(_mm256_fmadd_ps(value, scale, offset), _mm256_setzero_ps()), tableLast);
     // Lanes that classify as transparent; a non-finite value is one of them.
     __m256 clear = _mm256_or_ps(_mm256_cmp_ps(x, clearBelow, _CMP_LT_OQ), _mm256_cmp_ps(x, clearAbove, _CMP_GE_OQ));
-    __m256 finite = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    __m256 keep = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
     if constexpr (std::is_floating_point_v<T>) {
       const __m256 magnitude = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), value);
-      finite = _mm256_cmp_ps(magnitude, _mm256_set1_ps(FLT_MAX), _CMP_LE_OQ);
-      clear = _mm256_or_ps(clear, _mm256_andnot_ps(finite, _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
+      keep = _mm256_cmp_ps(magnitude, _mm256_set1_ps(FLT_MAX), _CMP_LE_OQ);
     }
-    if (_mm256_movemask_ps(clear) == 0xFF) continue;
+    if constexpr (decltype(kTail)::value) keep = _mm256_and_ps(keep, inRun);
+    constexpr bool kMasked = std::is_floating_point_v<T> || decltype(kTail)::value;
+    if constexpr (kMasked) clear = _mm256_or_ps(clear, _mm256_andnot_ps(keep, _mm256_castsi256_ps(_mm256_set1_epi32(-1))));
+    if (_mm256_movemask_ps(clear) == 0xFF) return false;
     // Classify.
     const __m256i entry = _mm256_min_epi32(_mm256_cvttps_epi32(x), entryLast);
     Quads c = classifyQuads(p.table, entry, _mm256_sub_ps(x, _mm256_cvtepi32_ps(entry)));
-    if constexpr (std::is_floating_point_v<T>) keepQuads(c, finite);
+    if constexpr (kMasked) keepQuads(c, keep);
     if constexpr (kShaded) {
       // Light the visible samples, all eight lanes at once (shade_lanes.h).
       shadeQuads<T, kPower, kShifted>(v, p, ray, batch.u, c);
     }
     // Composite the batch, then the batch into the ray.
     gathered = addBehind4(gathered, overQuads(c));
-    if (_mm256_cvtsd_f64(_mm256_permute4x64_pd(gathered, 0xFF)) >= p.earlyTermination) {
+    return _mm256_cvtsd_f64(_mm256_permute4x64_pd(gathered, 0xFF)) >= p.earlyTermination;
+  };
+  // The next batch's voxels are fetched before this batch's transparency
+  // test: a mispredicted skip then no longer discards the fetch in flight
+  // (peer scene: 15 % less CPU time, bench/results/plain.txt). Fetched only
+  // while samples of the run remain (the tail's too: its lanes past the run
+  // read clamped cells), so nothing outside the owned cells is read; the
+  // batch fetched ahead of one that terminates the ray is dropped.
+  Batch next = reconstruct(start);
+  for (std::int64_t s = start; s + 8 <= exit; s += 8, start = s) {
+    const Batch batch = next;
+    if (s + 8 == exit) exit = more(exit);
+    if (s + 8 < exit) next = reconstruct(s + 8);
+    samples += 8;
+    if (take(batch, std::false_type{}, __m256{})) {
       start = s + 8;
       terminated = true;
       break;
     }
+  }
+  // The run's last 1 to 7 samples, as one more batch with the lanes past
+  // the run masked out. One at a time (runScalar), each visible sample lit
+  // by the scalar gradient, they took 2.6 % of a shaded CT head frame for
+  // 1.2 % of its samples; as a batch, the frame takes 1.5-2 % less CPU
+  // (unshaded ~3 %; bench/results/shade.txt, session 11). Composited
+  // in float like any batch: within a few ulp of the batch's colour of the
+  // scalar loop's double "over" (kernel_batch_over.h), and early
+  // termination is tested after it, as after every batch.
+  if (!terminated && start < exit) {
+    const int count = int(exit - start);
+    samples += std::uint64_t(count);
+    terminated = take(next, std::true_type{}, _mm256_cmp_ps(lanes, _mm256_set1_ps(float(count)), _CMP_LT_OQ));
+    start = exit;
   }
   alignas(32) double out[4];
   _mm256_store_pd(out, gathered);

@@ -13,6 +13,7 @@
 #include "raycast/cast_ray.h"
 #include "raycast/kernel_setup.h"
 #include "raycast/macrocells.h"
+#include "batch_runs.h"
 #include "kernel_fixture.h"
 #include "reference.h"
 #include "transfer.h"
@@ -30,50 +31,11 @@ TransferFunctionSpec transfer(std::vector<TransferPoint> points) {
 }
 
 using Setup = KernelFixture;
-
-// A ray along +x through the middle of an n^3 grid, in index units.
-RaySetup alongX(double y, double z, double step) {
-  RaySetup r{};
-  r.origin[0] = 0;
-  r.origin[1] = y;
-  r.origin[2] = z;
-  r.step[0] = step;
-  r.invStep[0] = 1 / step;
-  r.leapPerMacrocell = MacrocellGrid::kSize / step;
-  r.light[2] = r.halfway[2] = 1;
-  return r;
-}
-
-struct Run {
-  kernel::Accumulator acc;
-  std::uint64_t samples = 0;
-  std::int64_t stoppedAt = 0;  // the batched run's `start` when it returned
-  bool terminated = false;
-};
-
-// Samples [first, last) one at a time (kPower: specular_power.h).
-template <typename V, bool kShaded, int kPower = kernel::kTablePower>
-Run scalarRun(const KernelParams& p, const RaySetup& ray, std::int64_t first, std::int64_t last) {
-  Run r;
-  r.terminated = kernel::runScalar<V, kShaded, false, kPower>(p, ray, first, last, r.acc, r.samples);
-  return r;
-}
-
-// Samples [first, last) batched, the rest one at a time.
-template <typename V, bool kShaded, int kPower = kernel::kTablePower>
-Run batchedRun(const KernelParams& p, const RaySetup& ray, std::int64_t first, std::int64_t last) {
-  Run r;
-  std::int64_t start = first;
-  r.terminated = kernel::runBatched<V, kShaded, kPower>(p, ray, start, last, r.acc, r.samples);
-  r.stoppedAt = start;
-  if (!r.terminated)
-    r.terminated = kernel::runScalar<V, kShaded, false, kPower>(p, ray, start, last, r.acc, r.samples);
-  return r;
-}
-
-double difference(const kernel::Accumulator& a, const kernel::Accumulator& b) {
-  return std::max({std::abs(a.r - b.r), std::abs(a.g - b.g), std::abs(a.b - b.b), std::abs(a.a - b.a)});
-}
+using test::alongX;
+using test::batchedRun;
+using test::difference;
+using test::Run;
+using test::scalarRun;
 
 }  // namespace
 
@@ -110,9 +72,7 @@ TEST_CASE("the batched plain kernel equals the scalar kernel", "[raycast]") {
     return field(q);
   });
   const Brick bytes = makeVolume(grid, ScalarType::kUInt8, [&](Vec3 q) { return 255 * field(q); });
-  const Vec3 c = grid.center();
-  const Camera camera = makeCamera(Projection::kPerspective, c - normalize(Vec3{0.3, 1, 0.5}) * 70.0, c,
-                                   {0, 0, 1}, 40, 24, 24);
+  const Camera camera = test::obliqueView(grid, 24);
   for (const Brick* volume : {&floats, &bytes}) {
     const bool uint8 = volume->type() == ScalarType::kUInt8;
     for (int mode : {0, 1, 2}) {  // unshaded; shaded, the power from the table; shaded, by steps
@@ -170,13 +130,8 @@ TEST_CASE("the batched plain kernel equals the scalar kernel on gathered integer
     for (TransferPoint& point : t.points) point.scalar = point.scalar * scale + offset;
     return t;
   };
-  struct Case {
-    ScalarType type;
-    double scale, offset;
-  };
-  const Vec3 c = grid.center();
-  const Camera camera = makeCamera(Projection::kPerspective, c - normalize(Vec3{0.3, 1, 0.5}) * 70.0, c,
-                                   {0, 0, 1}, 40, 24, 24);
+  using Case = test::ScaledType;
+  const Camera camera = test::obliqueView(grid, 24);
   const RenderOptions o = makeOptions(0.45, false, false);
   for (const Case& k : {Case{ScalarType::kUInt16, 60000, 0}, Case{ScalarType::kInt16, 60000, -30000},
                         Case{ScalarType::kUInt8, 255, 0}}) {
@@ -348,11 +303,12 @@ TEST_CASE("early termination inside a batch stops at the batch's end", "[raycast
 }
 
 // Each batch's voxels are fetched while the batch before it is classified
-// (kernel_batch.h): the batch fetched ahead is taken only when eight more
-// samples remain, and one fetched ahead of the batch that terminates the
-// ray is dropped. Runs of every length from 8 to 40 samples, starting at
-// every offset within a cell pair: the batches take the whole batches and
-// stop where they end, with what the scalar loop composites.
+// (kernel_batch.h): the batch fetched ahead is taken while samples of the
+// run remain (the last 1 to 7 as a masked batch, batch_tail_test.cpp), and
+// one fetched ahead of the batch that terminates the ray is dropped. Runs
+// of every length from 1 to 40 samples, starting at every offset within a
+// cell pair: the batches take the whole run and stop at its end, with what
+// the scalar loop composites.
 TEST_CASE("batches fetched ahead are taken for every run length", "[raycast]") {
   const GridGeometry grid = cubeGrid(33);
   const Brick wave = makeVolume(grid, ScalarType::kUInt8,
@@ -367,16 +323,15 @@ TEST_CASE("batches fetched ahead are taken for every run length", "[raycast]") {
   REQUIRE(kernel::sampleRange(s.p, ray, first, last));
   REQUIRE(last - first > 48);
   for (std::int64_t shift = 0; shift < 7; ++shift)
-    for (std::int64_t length = 8; length <= 40; ++length) {
+    for (std::int64_t length = 1; length <= 40; ++length) {
       const std::int64_t from = first + shift, to = from + length;
       const Run a = scalarRun<std::uint8_t, false>(s.p, ray, from, to);
       Run b;
       std::int64_t start = from;
       REQUIRE_FALSE(kernel::runBatched<std::uint8_t, false>(s.p, ray, start, to, b.acc, b.samples));
       INFO("shift " << shift << ", length " << length);
-      CHECK(start == from + length / 8 * 8);
-      CHECK(b.samples == std::uint64_t(length / 8 * 8));
-      REQUIRE_FALSE(kernel::runScalar<std::uint8_t, false, false>(s.p, ray, start, to, b.acc, b.samples));
+      CHECK(start == to);
+      CHECK(b.samples == std::uint64_t(length));
       CHECK(a.samples == b.samples);
       CHECK(difference(a.acc, b.acc) < 1e-6);
     }

@@ -45,6 +45,10 @@ struct Walked {
   RayResult result;
   int chunks = 0;          // chunks taken
   int followingOn = 0;     // chunks that start where the chunk before them ended
+  int lookUps = 0;         // pastEmpty() calls
+  int afterChunk = 0;      // look-ups where a chunk ended
+  int emptyAfterChunk = 0; // of those, the ones that found nothing visible
+  bool whole = true;       // every chunk whole batches, off the chord's ends
 };
 
 // The walk of RayWalk, one chunk a step, each chunk a runSpan of its own
@@ -70,11 +74,15 @@ Walked chunkPerStep(const KernelParams& p, const RaySetup& ray, int shift) {
     std::int64_t lastExit = -1;
     while (k <= end) {
       const std::int64_t next = kernel::pastEmpty(p, field, cube, o, d, k, shift);
+      ++w.lookUps;
+      w.afterChunk += k == lastExit;
       if (next != k) {
+        w.emptyAfterChunk += k == lastExit;
         k = next;
         continue;
       }
       const std::int64_t exit = std::min(last + 1, k + chunk);
+      w.whole = w.whole && k > ends.first && exit <= ends.last && (exit - k) % 8 == 0;
       ++w.chunks;
       w.followingOn += k == lastExit;
       if (kernel::runSpan<std::uint8_t, kShaded, false>(p, ray, ends, k, exit, acc, w.result.samples)) break;
@@ -140,6 +148,48 @@ TEST_CASE("chunks that follow on in the batch loop equal one chunk a step", "[ra
   }
 }
 
+// A walk looks a sample up once: where a chunk's batches end, the batch
+// loop looks up the next chunk (RayWalk::step's `chunks`), and when it
+// finds it empty the walk leaps from that look-up instead of making it
+// again in its next step. On rays whose chunks are all whole batches off
+// the chord's ends (so that the loop asks at every chunk's end), the walk
+// takes one step for each look-up the chunk-a-step walk makes other than
+// those where a chunk ended; and among those, hundreds found nothing
+// visible (the look-ups a step made again before).
+TEST_CASE("a walk looks up the sample after a chunk once", "[raycast]") {
+  const Brick volume = blobsVolume();
+  const TransferFunctionSpec tf =
+      tfOf({{0, 0, 0, 0, 0}, {30, 0.2, 0.5, 0.9, 0}, {120, 0.4, 0.8, 0.6, 0.08}, {200, 1, 0.5, 0.2, 0.3}}, 1.0);
+  const Vec3 c = volume.grid().center();
+  const Camera camera = makeCamera(Projection::kPerspective, c + Vec3{60, -80, 45}, c, {0, 0, 1}, 40, 64, 64);
+  for (double step : {0.5, 0.3}) {
+    INFO("step " << step);
+    const RenderOptions o = makeOptions(step);
+    const KernelFixture params(volume, tf, o, true);
+    const KernelParams& p = params.p;
+    int rays = 0, emptyAfterChunk = 0;
+    for (int y = 0; y < camera.height(); ++y)
+      for (int x = 0; x < camera.width(); ++x) {
+        const RaySetup ray = raySetup(camera.ray(x, y), volume.grid(), o.step, Vec3{0, 0, 1});
+        const Walked reference = chunkPerStep<false>(p, ray, MacrocellGrid::kShift);
+        if (!reference.result.hit || reference.chunks == 0 || !reference.whole) continue;
+        kernel::RayWalk<std::uint8_t, false, false> walk;
+        RayResult out;
+        int steps = 0;
+        if (walk.start(p, ray, MacrocellGrid::kShift, kernel::TileSpan{}, out))
+          do ++steps;
+          while (walk.step(p, ray, MacrocellGrid::kShift, out));
+        INFO("pixel " << x << ", " << y);
+        CHECK(out.colour.a == reference.result.colour.a);
+        CHECK(steps == reference.lookUps - reference.afterChunk);
+        ++rays;
+        emptyAfterChunk += reference.emptyAfterChunk;
+      }
+    CHECK(rays > 300);
+    CHECK(emptyAfterChunk > 300);
+  }
+}
+
 // runBatched's `more`, alone: a run of 16 samples whose batches follow on
 // once by 24 more equals one run of 40; one that declines stops at 16; and
 // `more` is asked only where whole batches end exactly at the run's end.
@@ -183,14 +233,16 @@ TEST_CASE("a batch loop that follows on equals one longer run", "[raycast]") {
     CHECK(followed.b == whole.b);
     CHECK(followed.a == whole.a);
     composited += whole.a > declined.a;
-    // Batches that end short of the run's end: `more` is not asked.
+    // Batches that end short of the run's end: `more` is not asked; the
+    // run's last samples are a batch of their own (batch_tail_test.cpp).
     std::int64_t d = from;
     kernel::Accumulator partial;
     std::uint64_t partialSamples = 0;
     asked.clear();
     REQUIRE_FALSE(kernel::runBatched<std::uint8_t, false>(p, ray, d, from + 21, partial, partialSamples, once));
     CHECK(asked.empty());
-    CHECK(d == from + 16);
+    CHECK(d == from + 21);
+    CHECK(partialSamples == 21);
   }
   CHECK(composited > 3);
 }
