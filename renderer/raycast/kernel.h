@@ -26,6 +26,9 @@ struct KernelParams {
   // Voxels of the stored box; index(i,j,k) = i*1 + j*strideY + k*strideZ + base.
   const void* voxels = nullptr;
   std::int64_t strideY = 0, strideZ = 0, base = 0;
+  // log2 of strideY and strideZ where both are powers of two, else -1: the
+  // batched kernel then finds voxel indices by shifts (voxelIndex8).
+  int strideShift[2] = {-1, -1};
   bool indices32 = false;  // every stored voxel index fits an int32 (the batched kernel's lanes)
   // Owned box in index units, for membership: lo <= u < hi, or u <= hi where
   // the box meets the far edge of the grid (hiClosed).

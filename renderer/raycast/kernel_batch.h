@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <cstring>
 #include <type_traits>
+#include <utility>
 
 #include "kernel.h"
 #include "preint_lanes.h"
@@ -52,9 +53,12 @@ struct NoFollowOn {
 // the whole batches end exactly at `exit`, more(exit) is where the batches
 // may go on to (exit itself: nowhere), and the loop goes on there as a new
 // call from `exit` would, with the same batches and so the same bits.
-template <typename T, bool kShaded, int kPower = kTablePower, typename More = NoFollowOn>
-inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
-                       std::int64_t exit, Accumulator& acc, std::uint64_t& samples, More&& more = More{}) {
+//
+// kShifted: voxel indices by shifts (KernelParams::strideShift, voxelIndex8);
+// runBatched picks it per call.
+template <typename T, bool kShaded, int kPower, bool kShifted, typename More>
+inline bool runBatchedIndexed(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
+                              std::int64_t exit, Accumulator& acc, std::uint64_t& samples, More&& more) {
   if (start >= exit) return false;
   const T* v = static_cast<const T*>(p.voxels);
   const float o[3] = {float(ray.origin[0]), float(ray.origin[1]), float(ray.origin[2])};
@@ -62,9 +66,7 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
   const __m256 o0 = _mm256_set1_ps(o[0]), o1 = _mm256_set1_ps(o[1]), o2 = _mm256_set1_ps(o[2]);
   const __m256 d0 = _mm256_set1_ps(d[0]), d1 = _mm256_set1_ps(d[1]), d2 = _mm256_set1_ps(d[2]);
   const __m256 lanes = _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256i strideY = _mm256_set1_epi32(std::int32_t(p.strideY));
-  const __m256i strideZ = _mm256_set1_epi32(std::int32_t(p.strideZ));
-  const __m256i base = _mm256_set1_epi32(std::int32_t(p.base));
+  const IndexLanes<kShifted> indexing(p);
   const __m256 scale = _mm256_set1_ps(p.tableScale), offset = _mm256_set1_ps(p.tableOffset);
   const __m256 tableLast = _mm256_set1_ps(float(p.tableEntries - 1));
   const __m256i entryLast = _mm256_set1_epi32(p.tableEntries - 2);
@@ -90,10 +92,7 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
     const __m256 fy = _mm256_sub_ps(u1, _mm256_cvtepi32_ps(j));
     const __m256 fz = _mm256_sub_ps(u2, _mm256_cvtepi32_ps(kk));
     alignas(32) std::int32_t index[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(index),
-                       _mm256_add_epi32(_mm256_add_epi32(i, base),
-                                        _mm256_add_epi32(_mm256_mullo_epi32(j, strideY),
-                                                         _mm256_mullo_epi32(kk, strideZ))));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(index), voxelIndex8(indexing, i, j, kk));
     // Trilinear reconstruction.
     __m256 a0, a1, b0, b1, c0, c1, e0, e1;
     loadPairs8(v, index, 0, a0, a1);
@@ -136,7 +135,7 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
     if constexpr (kMasked) keepQuads(c, keep);
     if constexpr (kShaded) {
       // Light the visible samples, all eight lanes at once (shade_lanes.h).
-      shadeQuads<T, kPower>(v, p, ray, batch.u, c);
+      shadeQuads<T, kPower, kShifted>(v, p, ray, batch.u, c);
     }
     // Composite the batch, then the batch into the ray.
     gathered = addBehind4(gathered, overQuads(c));
@@ -183,11 +182,19 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
   return terminated;
 }
 
+template <typename T, bool kShaded, int kPower = kTablePower, typename More = NoFollowOn>
+inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t& start, std::int64_t exit,
+                       Accumulator& acc, std::uint64_t& samples, More&& more = More{}) {
+  if (p.strideShift[0] >= 0)
+    return runBatchedIndexed<T, kShaded, kPower, true>(p, ray, start, exit, acc, samples, std::forward<More>(more));
+  return runBatchedIndexed<T, kShaded, kPower, false>(p, ray, start, exit, acc, samples, std::forward<More>(more));
+}
+
 // The scalars at samples [first, first + 8) as `around` reads them
 // (positions clamped into the domain, cells into the stored box): a
 // pre-integrated segment's ends may lie beyond the owned box. `lo` and
 // `hi` get the ranges of their cells' nodes (aroundRange()).
-template <typename T>
+template <typename T, bool kShifted = false>
 [[gnu::always_inline]] inline __m256 aroundBatch(const T* v, const KernelParams& p, const __m256 o[3],
                                                  const __m256 d[3], std::int64_t first, __m256& lo,
                                                  __m256& hi) {
@@ -202,9 +209,7 @@ template <typename T>
   }
   alignas(32) std::int32_t index[8];
   _mm256_store_si256(reinterpret_cast<__m256i*>(index),
-                     _mm256_add_epi32(_mm256_add_epi32(cell[0], _mm256_set1_epi32(std::int32_t(p.base))),
-                                      _mm256_add_epi32(_mm256_mullo_epi32(cell[1], _mm256_set1_epi32(std::int32_t(p.strideY))),
-                                                       _mm256_mullo_epi32(cell[2], _mm256_set1_epi32(std::int32_t(p.strideZ))))));
+                     voxelIndex8(IndexLanes<kShifted>(p), cell[0], cell[1], cell[2]));
   __m256 a0, a1, b0, b1, c0, c1, e0, e1;
   loadPairs8(v, index, 0, a0, a1);
   loadPairs8(v, index, p.strideY, b0, b1);
@@ -259,9 +264,10 @@ template <typename T>
 // and are not composited) and `start` ends at `exit`; without, the
 // segments are integrated per lane, eight at a time while eight remain, and
 // the caller takes the rest one at a time. `start` advances past what was
-// done. Returns true at the early-termination opacity.
-template <typename T, bool kShaded>
-inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
+// done. Returns true at the early-termination opacity. kShifted: voxel
+// indices by shifts (voxelIndex8); runBatchedPreintegrated picks it.
+template <typename T, bool kShaded, bool kShifted>
+inline bool runPreintegratedIndexed(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
                                     std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
 #ifdef PVR_HAVE_PREINT_LANES
   constexpr std::int64_t kFullBatchesOnly = 0;
@@ -302,7 +308,7 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   {
     alignas(32) float first[8], firstLo[8], firstHi[8];
     __m256 lo8, hi8;
-    _mm256_store_ps(first, aroundBatch(v, p, o, d, start - 1, lo8, hi8));
+    _mm256_store_ps(first, aroundBatch<T, kShifted>(v, p, o, d, start - 1, lo8, hi8));
     _mm256_store_ps(firstLo, lo8);
     _mm256_store_ps(firstHi, hi8);
     frontScalar = curvedNode<T>(first[0], first[1], first[2], firstLo[1], firstHi[1]);
@@ -345,11 +351,11 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
     // the ray terminates. aroundBatch() clamps its positions, so a batch
     // past `exit` would read inside the stored box as well.
     __m256 nextLo, nextHi;
-    __m256 nextAfter = aroundBatch(v, p, o, d, start + 2, nextLo, nextHi);
+    __m256 nextAfter = aroundBatch<T, kShifted>(v, p, o, d, start + 2, nextLo, nextHi);
     for (std::int64_t s = start; s + kFullBatchesOnly < exit; s += 8) {
       // The samples at s + 2 .. s + 9 (after), and at s .. s + 7 and s + 1 .. s + 8.
       const __m256 after = nextAfter, lo8 = nextLo, hi8 = nextHi;
-      if (s + 8 + kFullBatchesOnly < exit) nextAfter = aroundBatch(v, p, o, d, s + 10, nextLo, nextHi);
+      if (s + 8 + kFullBatchesOnly < exit) nextAfter = aroundBatch<T, kShifted>(v, p, o, d, s + 10, nextLo, nextHi);
       const __m256 before8 = shifted(carried, after, kTwo{}), at = shifted(carried, after, kOne{});
       const __m256 bend = _mm256_add_ps(_mm256_sub_ps(before8, _mm256_add_ps(at, at)), after);
       __m256 node = _mm256_sub_ps(at, _mm256_mul_ps(bend, _mm256_set1_ps(1.0f / 12.0f)));
@@ -416,8 +422,8 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
           __m256 u[2][3];
           litPoints8(o, d, s, seg, u);
           Quads back = batch;
-          shadeQuads(v, p, ray, u[0], batch);
-          shadeQuads(v, p, ray, u[1], back);
+          shadeQuads<T, kTablePower, kShifted>(v, p, ray, u[0], batch);
+          shadeQuads<T, kTablePower, kShifted>(v, p, ray, u[1], back);
           for (int j = 0; j < 4; ++j)
             batch.q[j] = _mm256_mul_ps(_mm256_add_ps(batch.q[j], back.q[j]), _mm256_set1_ps(0.5f));
         }
@@ -482,6 +488,13 @@ inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, 
   if (!kShaded && !p.preint.opaqueNodes) return batches(Rows{});
 #endif
   return batches(Cells{});
+}
+
+template <typename T, bool kShaded>
+inline bool runBatchedPreintegrated(const KernelParams& p, const RaySetup& ray, std::int64_t& start,
+                                    std::int64_t exit, Accumulator& acc, std::uint64_t& samples) {
+  if (p.strideShift[0] >= 0) return runPreintegratedIndexed<T, kShaded, true>(p, ray, start, exit, acc, samples);
+  return runPreintegratedIndexed<T, kShaded, false>(p, ray, start, exit, acc, samples);
 }
 
 }  // namespace pvr::core::kernel

@@ -15,6 +15,10 @@ void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocel
   p.strideY = ext.x;
   p.strideZ = ext.x * ext.y;
   p.base = -(st.lo.x + st.lo.y * p.strideY + st.lo.z * p.strideZ);
+  const auto log2Exact = [](std::int64_t n) { return n > 0 && (n & (n - 1)) == 0 ? __builtin_ctzll(n) : -1; };
+  const int shiftY = log2Exact(p.strideY), shiftZ = log2Exact(p.strideZ);
+  p.strideShift[0] = shiftY >= 0 && shiftZ >= 0 ? shiftY : -1;
+  p.strideShift[1] = shiftY >= 0 && shiftZ >= 0 ? shiftZ : -1;
   p.indices32 = st.nodeCount() < (std::int64_t(1) << 31) - 1;
   for (int a = 0; a < 3; ++a) {
     p.ownLo[a] = double(own.lo[a]);
@@ -137,8 +141,8 @@ std::vector<float> specularTable(double shininess) {
   return table;
 }
 
-RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step, const Vec3& lightWorld) {
-  RaySetup s;
+RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step) {
+  RaySetup s{};  // the lighting vectors zero
   for (int a = 0; a < 3; ++a) {
     s.origin[a] = (ray.origin[a] - grid.origin[a]) / grid.spacing[a];
     s.step[a] = ray.direction[a] * step / grid.spacing[a];
@@ -146,6 +150,11 @@ RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step, const V
   }
   const double major = std::max({std::abs(s.step[0]), std::abs(s.step[1]), std::abs(s.step[2])});
   s.leapPerMacrocell = double(MacrocellGrid::kSize) / major;
+  return s;
+}
+
+RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step, const Vec3& lightWorld) {
+  RaySetup s = raySetup(ray, grid, step);
   // Headlight by default: the light direction is fixed in camera space.
   // The viewer looks back along the ray.
   const Vec3 view = -ray.direction;

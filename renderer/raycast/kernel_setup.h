@@ -54,7 +54,11 @@ void setOptions(KernelParams& p, const RenderOptions& options, const float* spec
 std::vector<float> specularTable(double shininess);
 
 // The camera ray in `grid`'s index space, sample k at world distance
-// k * step, with the headlight's vectors: the light fixed in camera space,
+// k * step, without the lighting vectors (an unshaded kernel reads none:
+// they were a third of a ray's setup on the peer scene).
+RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step);
+
+// raySetup() with the headlight's vectors: the light fixed in camera space,
 // the viewer looking back along the ray.
 RaySetup raySetup(const Ray& ray, const GridGeometry& grid, double step, const Vec3& lightWorld);
 

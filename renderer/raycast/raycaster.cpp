@@ -159,6 +159,7 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
                                     : pickKernel(brick_.type(), options.shading.enabled, bool(preintegrated_),
                                                  kernel::powerBits(options.shading.shininess));
   const Vec3 lightWorld = normalize(camera.toWorld(options.shading.lightDirection));
+  const bool shaded = options.shading.enabled;  // only shaded kernels read a ray's lighting vectors
 
   // Tiles of the rectangle over the pool; each worker counts its own work.
   // A tile's rays are set up together, and where they can first and last
@@ -177,7 +178,9 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
         tile.width = x1 - x0;
         int n = 0;
         for (int y = y0; y < y1; ++y)
-          for (int x = x0; x < x1; ++x) tile.rays[n++] = raySetup(camera.ray(x, y), grid, step, lightWorld);
+          for (int x = x0; x < x1; ++x)
+            tile.rays[n++] = shaded ? raySetup(camera.ray(x, y), grid, step, lightWorld)
+                                    : raySetup(camera.ray(x, y), grid, step);
         tile.span = kernel::tileSpan(p, tile.rays, n, MacrocellGrid::kShift);
       },
       [&](const TileRays& tile, int x, int y, int n, RayResult* out) {

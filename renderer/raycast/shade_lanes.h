@@ -50,7 +50,7 @@ namespace pvr::core::kernel {
 // `wanted` (bit j: lane j), as kernel::gradient() computes them, up to
 // rounding; the other lanes' are unspecified (finite or not). g in world
 // units, one vector per axis.
-template <typename T>
+template <typename T, bool kShifted = false>
 [[gnu::always_inline]] inline void gradient8(const T* v, const KernelParams& p, const __m256 u[3], unsigned wanted,
                                              __m256 g[3]) {
   // Every lane where the interior form applies is computed by it, wanted
@@ -63,10 +63,7 @@ template <typename T>
   if (interior) {
     // Lanes not computed here read around the first lane that is, so every
     // load stays in the stored box.
-    const __m256i index0 = _mm256_add_epi32(
-        _mm256_add_epi32(cell[0], _mm256_set1_epi32(std::int32_t(p.base))),
-        _mm256_add_epi32(_mm256_mullo_epi32(cell[1], _mm256_set1_epi32(std::int32_t(p.strideY))),
-                         _mm256_mullo_epi32(cell[2], _mm256_set1_epi32(std::int32_t(p.strideZ)))));
+    const __m256i index0 = voxelIndex8(IndexLanes<kShifted>(p), cell[0], cell[1], cell[2]);
     const __m256i firstLane =
         _mm256_permutevar8x32_epi32(index0, _mm256_set1_epi32(__builtin_ctz(interior)));
     alignas(32) std::int32_t index[8];
@@ -152,14 +149,14 @@ template <typename T>
 // The batch's samples at positions u, colours c, lit as kernel::shade()
 // lights each: those with opacity > 0; the others are left as they are.
 // kPower: how nh^shininess is raised (specular_power.h).
-template <typename T, int kPower = kTablePower>
+template <typename T, int kPower = kTablePower, bool kShifted = false>
 [[gnu::always_inline]] inline void shadeQuads(const T* v, const KernelParams& p, const RaySetup& ray,
                                               const __m256 u[3], Quads& c) {
   const __m256 visible = _mm256_cmp_ps(alphaLanes(c), _mm256_setzero_ps(), _CMP_GT_OQ);
   const unsigned wanted = unsigned(_mm256_movemask_ps(visible));
   if (!wanted) return;
   __m256 g[3];
-  gradient8(v, p, u, wanted, g);
+  gradient8<T, kShifted>(v, p, u, wanted, g);
   // Blinn-Phong, two-sided; a zero or non-finite gradient is lit head-on.
   const __m256 gg = _mm256_fmadd_ps(g[2], g[2], _mm256_fmadd_ps(g[1], g[1], _mm256_mul_ps(g[0], g[0])));
   const __m256 lighted = _mm256_and_ps(_mm256_cmp_ps(gg, _mm256_set1_ps(1e-20f), _CMP_GT_OQ),

@@ -48,7 +48,10 @@ using test::scalarRun;
 // view, unshaded and shaded (the specular power from the table and by
 // steps, specular_power.h), uint8 and float32.
 TEST_CASE("the batched plain kernel equals the scalar kernel", "[raycast]") {
-  const GridGeometry grid = cubeGrid(40);
+  // 32: strides of powers of two, whose voxel indices the batch takes by
+  // shifts (KernelParams::strideShift); 40: by multiplies.
+  const std::int64_t n = GENERATE(40, 32);
+  const GridGeometry grid = cubeGrid(n);
   auto field = [](Vec3 q) { return 0.5 + 0.45 * std::sin(q.x * 0.31) * std::cos(q.y * 0.23 + q.z * 0.17); };
   const TransferFunctionSpec tf = transfer({{0.0, 0, 0, 0, 0},
                                             {0.3, 0.2, 0.5, 1.0, 0},
@@ -77,6 +80,7 @@ TEST_CASE("the batched plain kernel equals the scalar kernel", "[raycast]") {
       const RenderOptions o = makeOptions(0.45, false, shaded);
       Setup s(*volume, uint8 ? tf8 : tf, o);
       REQUIRE(s.p.indices32);
+      REQUIRE((s.p.strideShift[0] == 5 && s.p.strideShift[1] == 10) == (n == 32));
       REQUIRE(s.p.clearBelow > 0);
       REQUIRE(s.p.clearAbove < float(TransferTable::kEntries - 1));
       double worst = 0;
@@ -114,7 +118,7 @@ TEST_CASE("the batched plain kernel equals the scalar kernel", "[raycast]") {
 // last voxel: its 32-bit word reaches two bytes into Brick::kPaddingBytes,
 // which the pair must not take in.
 TEST_CASE("the batched plain kernel equals the scalar kernel on gathered integer voxels", "[raycast]") {
-  const std::int64_t n = 40;
+  const std::int64_t n = GENERATE(40, 32);  // indices by multiplies, by shifts
   const GridGeometry grid = cubeGrid(n);
   auto field = [](Vec3 q) { return 0.5 + 0.45 * std::sin(q.x * 0.31) * std::cos(q.y * 0.23 + q.z * 0.17); };
   auto scaled = [](double scale, double offset) {
@@ -134,6 +138,7 @@ TEST_CASE("the batched plain kernel equals the scalar kernel on gathered integer
     const Brick volume = makeVolume(grid, k.type, [&](Vec3 q) { return field(q) * k.scale + k.offset; });
     Setup s(volume, scaled(k.scale, k.offset), o);
     REQUIRE(s.p.indices32);
+    REQUIRE((s.p.strideShift[0] >= 0) == (n == 32));
     auto compare = [&](const RaySetup& ray, std::int64_t first, std::int64_t last) {
       return dispatchScalar(k.type, [&](auto tag) {
         using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
