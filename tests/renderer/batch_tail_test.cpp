@@ -53,9 +53,12 @@ TransferFunctionSpec bandsTransfer(double scale, double offset) {
 // the run are often visible (checked: the whole eighth batch differs), so
 // a lane not masked would differ by far more. int16 and uint8 voxels (one
 // gather per corner pair), float32 with non-finite voxels (masked as well);
-// unshaded and shaded; rays of a perspective view.
+// unshaded and shaded; rays of a perspective view; indices by multiplies
+// and by shifts.
 TEST_CASE("a run's last samples as a masked batch equal the scalar samples", "[raycast]") {
-  const GridGeometry grid = cubeGrid(40);
+  // 32: strides of powers of two, voxel indices by shifts (voxelIndex8).
+  const std::int64_t n = GENERATE(40, 32);
+  const GridGeometry grid = cubeGrid(n);
   using Case = test::ScaledType;
   const Camera camera = test::obliqueView(grid, 12);
   for (const Case& k : {Case{ScalarType::kInt16, 60000, -30000}, Case{ScalarType::kUInt8, 255, 0},
@@ -69,6 +72,7 @@ TEST_CASE("a run's last samples as a masked batch equal the scalar samples", "[r
       const RenderOptions o = makeOptions(0.45, false, shaded);
       const KernelFixture s(volume, bandsTransfer(k.scale, k.offset), o);
       REQUIRE(s.p.indices32);
+      REQUIRE((s.p.strideShift[0] >= 0) == (n == 32));
       double worst = 0;
       int runs = 0, leakWouldShow = 0;
       for (int y = 0; y < camera.height(); ++y)
