@@ -12,6 +12,7 @@
 #include "kernel_batch.h"
 #include "preint_lighting.h"
 #include "tile_start.h"
+#include "walk_lanes.h"
 
 namespace pvr::core {
 
@@ -268,6 +269,13 @@ class RayWalk {
       k_ = next;
       return k_ <= end_ || finish(out);
     }
+    return chunkAt(k_, p, ray, mcShift, out);
+  }
+
+  // step() after a look-up that found sample k's macrocell visible (k at
+  // or after where the walk was, past empty space, and within its end).
+  bool chunkAt(std::int64_t k, const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
+    k_ = k;
     // Something visible: sample a fixed chunk and look again. Samples that
     // run on into an empty macrocell add nothing, and a chunk costs one
     // look-up where walking the visible macrocells exactly (a 3D DDA)
@@ -312,12 +320,20 @@ class RayWalk {
     return k_ <= end_ || finish(out);
   }
 
- private:
   bool finish(RayResult& out) const {
     out.colour = acc_.rgba();
     return false;
   }
 
+  // The sample the walk looks at next.
+  std::int64_t at() const { return k_; }
+  // Lane i of `lanes` takes this walk's look-ups (walkInLanes).
+  template <typename Lanes>
+  void toLane(Lanes& lanes, int i) const {
+    lanes.set(i, o_, d_, cube_, field_, k_, end_);
+  }
+
+ private:
   std::int64_t first_ = 0, last_ = -1;  // the ray's samples in the brick
   std::int64_t k_ = 0, end_ = -1;       // the next sample to look at; the last in the visible box
   std::int64_t done_ = 0;               // next sample not yet composited or skipped
@@ -346,9 +362,10 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift, const
   return out;
 }
 
-// Rays rays[0, n) into out[0, n), n <= kRaysAtOnce: their walks by
-// turns, a step of each (see RayWalk), each ray as castRay would take it
-// (with the same `span`).
+// Rays rays[0, n) into out[0, n), n <= kRaysAtOnce, each as castRay
+// would take it (with the same `span`): their walks by turns, a step of
+// each (see RayWalk), with the look-ups of all of them in the lanes of one
+// vector where the CPU has AVX-512 (walk_lanes.h).
 template <typename T, bool kShaded, bool kPreintegrated, int kPower = kernel::kTablePower>
 void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan& span,
               RayResult* out) {
@@ -360,6 +377,9 @@ void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, c
     going[i] = walk[i].start(p, rays[i], mcShift, span, out[i]);
     left += going[i];
   }
+#ifdef PVR_HAVE_WALK_LANES
+  if (left > 0) kernel::walkInLanes(p, rays, n, mcShift, walk, going, out);
+#else
   while (left > 0) {
     for (int i = 0; i < n; ++i) {
       if (!going[i]) continue;
@@ -367,6 +387,7 @@ void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, c
       left -= !going[i];
     }
   }
+#endif
 }
 
 }  // namespace pvr::core

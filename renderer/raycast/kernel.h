@@ -89,8 +89,16 @@ struct RaySetup {
 // Rays a caster takes at once, neighbours along a row (castRays in
 // cast_ray.h, renderTileRuns in tiles.h): a ray's walk through empty space
 // is a chain of dependent look-ups, and the walks of four rays by turns
-// overlap in the CPU (peer scene: 10-15 % less CPU time than one at a time).
+// overlap in the CPU (peer scene: 10-15 % less CPU time than one at a time;
+// eight by turns gained nothing more). With AVX-512, eight: their look-ups
+// go in the eight lanes of one vector (walk_lanes.h; four lanes of 256 bits
+// were no faster than four rays by turns, bench/results/walk.txt).
+#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__FMA__)
+#define PVR_HAVE_WALK_LANES 1
+inline constexpr int kRaysAtOnce = 8;
+#else
 inline constexpr int kRaysAtOnce = 4;
+#endif
 
 struct RayResult {
   Rgba colour;
@@ -526,6 +534,10 @@ class CubeExit {
     for (int a = 0; a < 3; ++a) exitK = std::min(exitK, double(m[a] + sign_[a] * distance) * scale_[a] + base_[a]);
     return std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(std::min(exitK, 1e18))));
   }
+  // The terms of exit() along axis a, for its lanes (walk_lanes.h).
+  double scale(int a) const { return scale_[a]; }
+  double base(int a) const { return base_[a]; }
+  int sign(int a) const { return sign_[a]; }
 
  private:
   double scale_[3] = {0, 0, 0}, base_[3] = {1e300, 1e300, 1e300};
