@@ -205,7 +205,7 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
                                                      std::int64_t k, int mcShift) {
   int m[3];
   for (int a = 0; a < 3; ++a)
-    m[a] = std::clamp(int(o[a] + float(k) * d[a]) >> mcShift, p.mcFirst[a], p.mcFirst[a] + p.mcCount[a] - 1);
+    m[a] = std::clamp(int(walkMulAdd(float(k), d[a], o[a])) >> mcShift, p.mcFirst[a], p.mcFirst[a] + p.mcCount[a] - 1);
   const int distance = field[macrocellIndex(p, m)];
   if (distance == 0) return k;
   return cube.exit(m, distance, k);

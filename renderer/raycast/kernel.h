@@ -503,6 +503,21 @@ inline int octantOf(const RaySetup& r) { return directionOctant(r.step); }
 inline constexpr std::int64_t kVisibleChunk = 16;
 inline std::int64_t visibleChunk(const RaySetup& r) { return r.leapPerMacrocell >= 8 ? 2 * kVisibleChunk : kVisibleChunk; }
 
+// a * b + c for the walk's look-ups (pastEmpty, CubeExit::exit): rounded
+// once, as their lanes compute it (walk_lanes.h), wherever the CPU has
+// FMA. Written out, GCC's -ffp-contract=fast fuses it or not depending on
+// the code around it, so the same look-up rounded differently in different
+// callers (and a position a rounding away from a macrocell face landed in
+// the neighbouring macrocell).
+template <typename F>
+[[gnu::always_inline]] inline F walkMulAdd(F a, F b, F c) {
+#ifdef __FMA__
+  return std::fma(a, b, c);
+#else
+  return a * b + c;
+#endif
+}
+
 // The first sample at or after the ray leaves the cube of macrocells
 // within `distance - 1` of macrocell m (global index), never less than
 // k + 1: where a macrocell's distance field value (MacrocellGrid::
@@ -531,7 +546,7 @@ class CubeExit {
   }
   std::int64_t exit(const int m[3], int distance, std::int64_t k) const {
     double exitK = 1e300;
-    for (int a = 0; a < 3; ++a) exitK = std::min(exitK, double(m[a] + sign_[a] * distance) * scale_[a] + base_[a]);
+    for (int a = 0; a < 3; ++a) exitK = std::min(exitK, walkMulAdd(double(m[a] + sign_[a] * distance), scale_[a], base_[a]));
     return std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(std::min(exitK, 1e18))));
   }
   // The terms of exit() along axis a, for its lanes (walk_lanes.h).

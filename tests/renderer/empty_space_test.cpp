@@ -360,15 +360,23 @@ TEST_CASE("a frame leaps by the forward fields of its rays' octants", "[raycast]
   }
 }
 
-// castRays takes up to kRaysAtOnce rays' walks by turns: each ray's
-// result must be exactly castRay's for it (colour, samples, hit), whatever
-// its neighbours do: rays that miss the brick, miss the visible box, cross
-// the speck, the blob, or stop early at the early-termination opacity, in
-// runs of every length; plain, pre-integrated and shaded.
+// castRays takes up to kRaysAtOnce rays' walks by turns (with AVX-512,
+// their look-ups in vector lanes, walk_lanes.h): each ray's result must be
+// exactly castRay's for it (colour, samples, hit), whatever its neighbours
+// do: rays that miss the brick, miss the visible box, cross the speck, the
+// blob, or stop early at the early-termination opacity, in runs of every
+// length; plain, pre-integrated and shaded; from the eight corners (every
+// octant, each leaping by its own forward field) and from inside.
 TEST_CASE("rays cast by turns equal rays cast one at a time", "[raycast]") {
   const Brick volume = speckVolume();
   const TransferFunctionSpec tf = blobAndSpeck();
-  const Camera camera = makeCamera(Projection::kPerspective, {70, -35, 60}, {22, 18, 24}, {0, 0, 1}, 22, 40, 40);
+  std::vector<Camera> cameras = {
+      makeCamera(Projection::kPerspective, {70, -35, 60}, {22, 18, 24}, {0, 0, 1}, 22, 40, 40),
+      makeCamera(Projection::kPerspective, {21, 18, 20}, {30, 26, 25}, {0, 0, 1}, 110, 24, 24)};
+  for (int corner = 0; corner < 8; ++corner)
+    cameras.push_back(makeCamera(Projection::kPerspective,
+                                 {corner & 1 ? 75.0 : -35.0, corner & 2 ? 72.0 : -32.0, corner & 4 ? 70.0 : -30.0},
+                                 {20, 19, 21}, {0, 0, 1}, 40, 24, 24));
   for (bool pre : {false, true}) {
     for (bool shaded : {false, true}) {
       INFO((pre ? "preintegrated" : "plain") << (shaded ? " shaded" : ""));
@@ -383,37 +391,48 @@ TEST_CASE("rays cast by turns equal rays cast one at a time", "[raycast]") {
       setTables(p, table, pre ? &preintegrated : nullptr, o.step);
       const std::vector<float> specular = specularTable(o.shading.shininess);
       setOptions(p, o, specular.data());
-      const Vec3 light = normalize(camera.toWorld(o.shading.lightDirection));
+      std::vector<std::uint8_t> forward[8];  // every octant's own field
+      for (int oct = 0; oct < 8; ++oct) {
+        forward[oct].assign(macrocells.distance(), macrocells.distance() + macrocells.count().product());
+        forwardLeapDistance(forward[oct].data(), macrocells.count(), oct);
+        p.leapField[oct] = forward[oct].data();
+      }
       auto one = pre ? (shaded ? &castRay<std::uint8_t, true, true> : &castRay<std::uint8_t, false, true>)
                      : (shaded ? &castRay<std::uint8_t, true, false> : &castRay<std::uint8_t, false, false>);
       auto turns = pre ? (shaded ? &castRays<std::uint8_t, true, true> : &castRays<std::uint8_t, false, true>)
                        : (shaded ? &castRays<std::uint8_t, true, false> : &castRays<std::uint8_t, false, false>);
-      int hits = 0, terminated = 0;
-      for (int y = 0; y < camera.height(); ++y) {
-        for (int x = 0, n = 1; x < camera.width(); x += n, n = n % kRaysAtOnce + 1) {
-          const int count = std::min(n, camera.width() - x);
-          RaySetup rays[kRaysAtOnce];
-          for (int i = 0; i < count; ++i) rays[i] = raySetup(camera.ray(x + i, y), volume.grid(), o.step, light);
-          RayResult together[kRaysAtOnce];
-          turns(p, rays, count, MacrocellGrid::kShift, kernel::TileSpan{}, together);
-          for (int i = 0; i < count; ++i) {
-            const RayResult alone = one(p, rays[i], MacrocellGrid::kShift, kernel::TileSpan{});
-            INFO("pixel " << x + i << ", " << y);
-            CHECK(together[i].hit == alone.hit);
-            CHECK(together[i].samples == alone.samples);
-            CHECK(together[i].colour.r == alone.colour.r);
-            CHECK(together[i].colour.g == alone.colour.g);
-            CHECK(together[i].colour.b == alone.colour.b);
-            CHECK(together[i].colour.a == alone.colour.a);
-            hits += alone.samples > 0;
-            terminated += alone.colour.a >= 0.5f;
+      int hits = 0, terminated = 0, octants = 0, rayCount = 0;
+      for (const Camera& camera : cameras) {
+        const Vec3 light = normalize(camera.toWorld(o.shading.lightDirection));
+        for (int y = 0; y < camera.height(); ++y) {
+          for (int x = 0, n = 1; x < camera.width(); x += n, n = n % kRaysAtOnce + 1) {
+            const int count = std::min(n, camera.width() - x);
+            RaySetup rays[kRaysAtOnce];
+            for (int i = 0; i < count; ++i) rays[i] = raySetup(camera.ray(x + i, y), volume.grid(), o.step, light);
+            RayResult together[kRaysAtOnce];
+            turns(p, rays, count, MacrocellGrid::kShift, kernel::TileSpan{}, together);
+            for (int i = 0; i < count; ++i) {
+              const RayResult alone = one(p, rays[i], MacrocellGrid::kShift, kernel::TileSpan{});
+              INFO("pixel " << x + i << ", " << y);
+              CHECK(together[i].hit == alone.hit);
+              CHECK(together[i].samples == alone.samples);
+              CHECK(together[i].colour.r == alone.colour.r);
+              CHECK(together[i].colour.g == alone.colour.g);
+              CHECK(together[i].colour.b == alone.colour.b);
+              CHECK(together[i].colour.a == alone.colour.a);
+              hits += alone.samples > 0;
+              terminated += alone.colour.a >= 0.5f;
+              octants |= 1 << kernel::octantOf(rays[i]);
+              ++rayCount;
+            }
           }
         }
       }
-      // The view must hold every kind of ray for the check to mean anything.
-      CHECK(hits > 100);
-      CHECK(hits < camera.width() * camera.height() - 100);
-      CHECK(terminated > 10);
+      // The views must hold every kind of ray for the check to mean anything.
+      CHECK(hits > 1000);
+      CHECK(hits < rayCount - 1000);
+      CHECK(terminated > 100);
+      CHECK(octants == 0xff);
     }
   }
 }
