@@ -546,7 +546,8 @@ class CubeExit {
   }
   std::int64_t exit(const int m[3], int distance, std::int64_t k) const {
     double exitK = 1e300;
-    for (int a = 0; a < 3; ++a) exitK = std::min(exitK, walkMulAdd(double(m[a] + sign_[a] * distance), scale_[a], base_[a]));
+    for (int a = 0; a < 3; ++a)
+      exitK = std::min(exitK, walkMulAdd(double(m[a] + sign_[a] * distance), scale_[a], base_[a]));
     return std::max<std::int64_t>(k + 1, std::int64_t(std::ceil(std::min(exitK, 1e18))));
   }
   // The terms of exit() along axis a, for its lanes (walk_lanes.h).

@@ -10,7 +10,7 @@
 // rays by turns overlap their four chains; one vector of four lanes made
 // the four into a single longer chain and was no faster. Eight lanes take
 // about twice the look-ups per chain (peer scene: the walk's own CPU time
-// 47-48 ms a frame against 54-68 ms by turns; bench/results/walk.txt).
+// 47-48 ms a frame against 53-68 ms by turns; bench/results/walk.txt).
 #pragma once
 
 #include "kernel.h"
