@@ -90,12 +90,13 @@ struct RaySetup {
 // cast_ray.h, renderTileRuns in tiles.h): a ray's walk through empty space
 // is a chain of dependent look-ups, and the walks of four rays by turns
 // overlap in the CPU (peer scene: 10-15 % less CPU time than one at a time;
-// eight by turns gained nothing more). With AVX-512, eight: their look-ups
-// go in the eight lanes of one vector (walk_lanes.h; four lanes of 256 bits
-// were no faster than four rays by turns, bench/results/walk.txt).
+// eight by turns gained nothing more). With AVX-512, sixteen (a tile's
+// row): their look-ups go in the eight lanes of two vectors (walk_lanes.h;
+// four lanes of 256 bits were no faster than four rays by turns,
+// bench/results/walk.txt).
 #if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__FMA__)
 #define PVR_HAVE_WALK_LANES 1
-inline constexpr int kRaysAtOnce = 8;
+inline constexpr int kRaysAtOnce = 16;
 #else
 inline constexpr int kRaysAtOnce = 4;
 #endif

@@ -1,16 +1,17 @@
-// The empty-space look-ups of castRays' rays in the eight lanes of one
-// AVX-512 vector (walkInLanes): pastEmpty()'s position, macrocell and
+// The empty-space look-ups of castRays' rays in the eight lanes of AVX-512
+// vectors (walkInLanes): pastEmpty()'s position, macrocell and
 // distance byte, and CubeExit::exit()'s leap, each lane with exactly the
 // scalar arithmetic (the same fused multiply-adds, truncations and
 // rounding up), so every lane lands on the sample its ray's scalar walk
 // would, and the rays take the same chunks: the same images, bit for bit.
 //
-// Why eight lanes of 512 bits: a look-up is one chain of dependent
-// arithmetic and a load (~100 cycles in lanes). The scalar walks of four
-// rays by turns overlap their four chains; one vector of four lanes made
-// the four into a single longer chain and was no faster. Eight lanes take
-// about twice the look-ups per chain (peer scene: the walk's own CPU time
-// 47-48 ms a frame against 53-68 ms by turns; bench/results/walk.txt).
+// Why two vectors of eight lanes of 512 bits: a look-up is one chain of
+// dependent arithmetic and a load (~100 cycles in lanes). The scalar walks
+// of four rays by turns overlap their four chains; one vector of four
+// lanes made the four into a single longer chain and was no faster. Eight
+// lanes take about twice the look-ups per chain (peer scene: the walk's
+// own CPU time 47-48 ms a frame against 53-68 ms by turns), and two such
+// vectors taken by turns overlap their chains (bench/results/walk.txt).
 #pragma once
 
 #include "kernel.h"
@@ -26,7 +27,10 @@
 namespace pvr::core::kernel {
 
 inline constexpr int kWalkLanes = 8;
-static_assert(kRaysAtOnce == kWalkLanes, "castRays takes its rays' look-ups in one vector");
+// Vectors of look-ups taken by turns: two chains that overlap in the CPU
+// (peer scene: 1-2 % less CPU a frame than one vector of eight rays).
+inline constexpr int kWalkVectors = 2;
+static_assert(kRaysAtOnce == kWalkVectors * kWalkLanes, "castRays takes its rays' look-ups in kWalkVectors vectors");
 
 // Eight walks' look-ups. Masked intrinsics with every lane set
 // (preint::kAll): the unmasked forms start from GCC 12's "undefined"
@@ -121,40 +125,63 @@ class WalkLanes {
 };
 
 // castRays' walks (RayWalk) walk[0, n), going[i] when walk i has started
-// and is not done, to their ends: each round one vector look-up for all of
-// them; the walks whose look-up lands past their end are done, those that
-// find their macrocell visible take a chunk (RayWalk::chunkAt), the others
-// leap on in their lanes. Each walk takes the look-ups, leaps and chunks
-// RayWalk::step would, in the same order, so its result is castRay's.
+// and is not done, to their ends: each round one vector look-up for each
+// eight of them; the walks whose look-up lands past their end are done,
+// those that find their macrocell visible take a chunk (RayWalk::chunkAt),
+// the others leap on in their lanes. Each walk takes the look-ups, leaps
+// and chunks RayWalk::step would, in the same order, so its result is
+// castRay's.
 template <typename Walk>
 void walkInLanes(const KernelParams& p, const RaySetup* rays, int n, int mcShift, Walk* walk, const bool* going,
                  RayResult* out) {
-  unsigned live = 0;
-  for (int i = 0; i < n; ++i) live |= unsigned(going[i]) << i;
-  if (!live) return;
+  // live[g] bit i: walk g * kWalkLanes + i is going.
+  unsigned live[kWalkVectors] = {}, all = 0;
+  for (int i = 0; i < n; ++i) {
+    live[i / kWalkLanes] |= unsigned(going[i]) << (i % kWalkLanes);
+    all |= unsigned(going[i]) << i;
+  }
+  if (!all) return;
   // Lanes without a walk (absent, or done at the start) look up with a
   // live walk's ray; their results are never read.
-  WalkLanes lanes(p, mcShift);
-  const int any = __builtin_ctz(live);
-  for (int i = 0; i < kWalkLanes; ++i) walk[(live >> i) & 1 ? i : any].toLane(lanes, i);
-  __m512i k = lanes.start();
-  const __m512i end = lanes.end();
+  const int any = __builtin_ctz(all);
+  WalkLanes lanes[kWalkVectors] = {{p, mcShift}, {p, mcShift}};
+  __m512i k[kWalkVectors], end[kWalkVectors];
+  for (int g = 0; g < kWalkVectors; ++g) {
+    for (int i = 0; i < kWalkLanes; ++i) {
+      const int r = g * kWalkLanes + i;
+      walk[(all >> r) & 1 ? r : any].toLane(lanes[g], i);
+    }
+    k[g] = lanes[g].start();
+    end[g] = lanes[g].end();
+  }
+  auto anyLive = [&] {
+    unsigned on = 0;
+    for (const unsigned l : live) on |= l;
+    return on;
+  };
   alignas(64) std::int64_t at[kWalkLanes];
-  while (live) {
-    const __m512i next = lanes.next(k);
-    const unsigned visible = unsigned(_mm512_cmpeq_epi64_mask(next, k)) & live;
-    const unsigned past = unsigned(_mm512_cmpgt_epi64_mask(next, end)) & live & ~visible;
-    k = next;
-    if (!(visible | past)) continue;  // all leapt, and none past its end
-    for (unsigned bits = past; bits; bits &= bits - 1) walk[__builtin_ctz(bits)].finish(out[__builtin_ctz(bits)]);
-    live &= ~past;
-    _mm512_store_si512(at, k);
-    for (unsigned bits = visible; bits; bits &= bits - 1) {
-      const int i = __builtin_ctz(bits);
-      if (walk[i].chunkAt(at[i], p, rays[i], mcShift, out[i]))
-        k = _mm512_mask_set1_epi64(k, __mmask8(1u << i), walk[i].at());
-      else
-        live &= ~(1u << i);
+  while (anyLive()) {
+    // Every vector's look-up first, so that their chains overlap.
+    __m512i next[kWalkVectors];
+    for (int g = 0; g < kWalkVectors; ++g) next[g] = lanes[g].next(k[g]);
+    for (int g = 0; g < kWalkVectors; ++g) {
+      const unsigned visible = unsigned(_mm512_cmpeq_epi64_mask(next[g], k[g])) & live[g];
+      const unsigned past = unsigned(_mm512_cmpgt_epi64_mask(next[g], end[g])) & live[g] & ~visible;
+      k[g] = next[g];
+      if (!(visible | past)) continue;  // all leapt, and none past its end
+      Walk* w = walk + g * kWalkLanes;
+      RayResult* o = out + g * kWalkLanes;
+      const RaySetup* r = rays + g * kWalkLanes;
+      for (unsigned bits = past; bits; bits &= bits - 1) w[__builtin_ctz(bits)].finish(o[__builtin_ctz(bits)]);
+      live[g] &= ~past;
+      _mm512_store_si512(at, k[g]);
+      for (unsigned bits = visible; bits; bits &= bits - 1) {
+        const int i = __builtin_ctz(bits);
+        if (w[i].chunkAt(at[i], p, r[i], mcShift, o[i]))
+          k[g] = _mm512_mask_set1_epi64(k[g], __mmask8(1u << i), w[i].at());
+        else
+          live[g] &= ~(1u << i);
+      }
     }
   }
 }
