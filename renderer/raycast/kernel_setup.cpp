@@ -1,6 +1,7 @@
 #include "kernel_setup.h"
 
 #include <algorithm>
+#include <bit>
 #include <cfloat>
 #include <cmath>
 
@@ -15,7 +16,9 @@ void setBrick(KernelParams& p, const Brick& brick, const MacrocellGrid& macrocel
   p.strideY = ext.x;
   p.strideZ = ext.x * ext.y;
   p.base = -(st.lo.x + st.lo.y * p.strideY + st.lo.z * p.strideZ);
-  const auto log2Exact = [](std::int64_t n) { return n > 0 && (n & (n - 1)) == 0 ? __builtin_ctzll(n) : -1; };
+  const auto log2Exact = [](std::int64_t n) {
+    return n > 0 && std::has_single_bit(std::uint64_t(n)) ? std::countr_zero(std::uint64_t(n)) : -1;
+  };
   const int shiftY = log2Exact(p.strideY), shiftZ = log2Exact(p.strideZ);
   p.strideShift[0] = shiftY >= 0 && shiftZ >= 0 ? shiftY : -1;
   p.strideShift[1] = shiftY >= 0 && shiftZ >= 0 ? shiftZ : -1;
