@@ -78,30 +78,63 @@ template <typename T>
   high = _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(front, back, 0xDD)), 0xD8));
 }
 
-// Voxels index[j] + offset and index[j] + offset + 1 of eight lanes.
-//
-// Integer voxels: one hardware gather of a 32-bit word per lane, which
-// holds both neighbours (8-bit voxels: and two more, masked off by
-// splitPairs8; the brick's storage ends with Brick::kPaddingBytes, so a
-// word at its last voxel is readable). Eight scalar loads, each moved into
-// its lane by an insert, took more of the batch's shuffle port than the
-// gather does (peer scene, with classifyQuads reading offsets from memory:
-// 15 % less CPU time).
+// How loadPairs8 fetches integer voxels' words: by the hardware gather, or
+// by eight masked broadcast loads (AVX-512VL: a load and a blend each).
+// Which is faster depends on the core, not on the code around it: on Intel
+// (Emerald Rapids) an eight-lane gather takes 1.64 ns in L1 and the
+// broadcasts made the peer scene's frame 7 % slower; AMD's Zen cores
+// microcode their gathers (Zen 5: ~10 ns for one, four a batch took more
+// than half the unshaded batch's time) and the broadcasts are the faster
+// (bench/results/plain.txt, section 6). -march=native tells us which core
+// this build is for.
+#if defined(__AVX512F__) && defined(__AVX512VL__) && \
+    (defined(__znver1__) || defined(__znver2__) || defined(__znver3__) || defined(__znver4__) || defined(__znver5__))
+inline constexpr bool kBroadcastPairs = true;
+#else
+inline constexpr bool kBroadcastPairs = false;
+#endif
+
+// The 32-bit words at b + index[j] (in T's units) of eight lanes, by the
+// hardware gather.
 template <typename T>
-[[gnu::always_inline]] inline void loadPairs8(const T* v, __m256i index, std::int64_t offset, __m256& lo,
-                                              __m256& hi) {
-  static_assert(!std::is_floating_point_v<T>, "float pairs load as 64-bit words (load64x8)");
-  const __m256i words = _mm256_i32gather_epi32(reinterpret_cast<const int*>(v + offset), index, sizeof(T));
-  splitPairs8<T>(words, lo, hi);
+[[gnu::always_inline]] inline __m256i gatherWords8(const T* b, const std::int32_t* index) {
+  return _mm256_i32gather_epi32(reinterpret_cast<const int*>(b),
+                                _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)), sizeof(T));
 }
 
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+// gatherWords8() by eight loads, each broadcast into its lane under a mask.
+template <typename T>
+[[gnu::always_inline]] inline __m256i broadcastWords8(const T* b, const std::int32_t* index) {
+  auto word = [b, index](int j) __attribute__((always_inline)) {
+    std::int32_t w;
+    std::memcpy(&w, b + index[j], sizeof w);
+    return w;
+  };
+  __m256i words = _mm256_set1_epi32(word(0));
+  for (int j = 1; j < 8; ++j) words = _mm256_mask_set1_epi32(words, __mmask8(1u << j), word(j));
+  return words;
+}
+#endif
+
+// Voxels index[j] + offset and index[j] + offset + 1 of eight lanes.
+//
+// Integer voxels: one 32-bit word per lane, which holds both neighbours
+// (8-bit voxels: and two more, masked off by splitPairs8; the brick's
+// storage ends with Brick::kPaddingBytes, so a word at its last voxel is
+// readable), gathered or broadcast (kBroadcastPairs). Eight scalar loads,
+// each moved into its lane by an insert, took more of the batch's shuffle
+// port than the gather does on Intel (peer scene, with classifyQuads
+// reading offsets from memory: 15 % less CPU time).
 template <typename T>
 [[gnu::always_inline]] inline void loadPairs8(const T* v, const std::int32_t* index, std::int64_t offset,
                                               __m256& lo, __m256& hi) {
   if constexpr (std::is_floating_point_v<T>) {
     load64x8(v + offset, index, lo, hi);
+  } else if constexpr (kBroadcastPairs) {
+    splitPairs8<T>(broadcastWords8(v + offset, index), lo, hi);
   } else {
-    loadPairs8(v, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)), offset, lo, hi);
+    splitPairs8<T>(gatherWords8(v + offset, index), lo, hi);
   }
 }
 
