@@ -11,6 +11,7 @@
 #include "kernel.h"
 #include "kernel_batch.h"
 #include "preint_lighting.h"
+#include "start_lanes.h"
 #include "tile_start.h"
 #include "walk_lanes.h"
 
@@ -246,10 +247,21 @@ class RayWalk {
     out.hit = true;
     // The walk starts and ends at the visible box; a ray that misses it
     // costs nothing more.
-    k_ = first_;
-    end_ = last_;
-    if (!clipToWalk(p, ray, span, k_, end_)) return false;
-    ends_ = chordEnds(p, ray, first_, last_);
+    WalkStart at{first_, last_, first_, last_, {}};
+    if (!clipToWalk(p, ray, span, at.k, at.end)) return false;
+    at.ends = chordEnds(p, ray, first_, last_);
+    begin(p, ray, mcShift, at);
+    return true;
+  }
+
+  // Sets the walk up from where it starts (start(), or startInLanes in
+  // start_lanes.h, which finds the same for eight rays at once).
+  void begin(const KernelParams& p, const RaySetup& ray, int mcShift, const WalkStart& at) {
+    first_ = at.first;
+    last_ = at.last;
+    k_ = at.k;
+    end_ = at.end;
+    ends_ = at.ends;
     for (int a = 0; a < 3; ++a) {
       o_[a] = float(ray.origin[a]);
       d_[a] = float(ray.step[a]);
@@ -259,7 +271,6 @@ class RayWalk {
     chunk_ = visibleChunk(ray);
     cube_ = CubeExit(ray, mcShift);
     field_ = p.leapField[octantOf(ray)];
-    return true;
   }
 
   // One look-up, and a chunk of samples where it finds something visible.
@@ -327,6 +338,8 @@ class RayWalk {
 
   // The sample the walk looks at next.
   std::int64_t at() const { return k_; }
+  // Where the walk started (begin), before it took a step.
+  WalkStart started() const { return {first_, last_, k_, end_, ends_}; }
   // Lane i of `lanes` takes this walk's look-ups (walkInLanes).
   template <typename Lanes>
   void toLane(Lanes& lanes, int i) const {
@@ -365,21 +378,23 @@ RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift, const
 // Rays rays[0, n) into out[0, n), n <= kRaysAtOnce, each as castRay
 // would take it (with the same `span`): their walks by turns, a step of
 // each (see RayWalk), with the look-ups of all of them in the lanes of one
-// vector where the CPU has AVX-512 (walk_lanes.h).
+// vector where the CPU has AVX-512 (walk_lanes.h), and their starts
+// there eight at once too (start_lanes.h).
 template <typename T, bool kShaded, bool kPreintegrated, int kPower = kernel::kTablePower>
 void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan& span,
               RayResult* out) {
   kernel::RayWalk<T, kShaded, kPreintegrated, kPower> walk[kRaysAtOnce];
   bool going[kRaysAtOnce];
+#ifdef PVR_HAVE_WALK_LANES
+  const int left = kernel::startInLanes(p, rays, n, mcShift, span, walk, going, out);
+  if (left > 0) kernel::walkInLanes(p, rays, n, mcShift, walk, going, out);
+#else
   int left = 0;
   for (int i = 0; i < n; ++i) {
     out[i] = RayResult{};
     going[i] = walk[i].start(p, rays[i], mcShift, span, out[i]);
     left += going[i];
   }
-#ifdef PVR_HAVE_WALK_LANES
-  if (left > 0) kernel::walkInLanes(p, rays, n, mcShift, walk, going, out);
-#else
   while (left > 0) {
     for (int i = 0; i < n; ++i) {
       if (!going[i]) continue;

@@ -345,11 +345,27 @@ template <typename T, int kPower = kTablePower>
   return {c.r * lit + spec, c.g * lit + spec, c.b * lit + spec, c.a};
 }
 
+// a * b + c for the walk's look-ups (pastEmpty, CubeExit::exit) and the
+// membership tests of a ray's start (inside, inDomain): rounded once, as
+// their lanes compute it (walk_lanes.h, start_lanes.h), wherever the CPU
+// has FMA. Written out, GCC's -ffp-contract=fast fuses it or not
+// depending on the code around it, so the same look-up rounded
+// differently in different callers (and a position a rounding away from a
+// macrocell face landed in the neighbouring macrocell).
+template <typename F>
+[[gnu::always_inline]] inline F walkMulAdd(F a, F b, F c) {
+#ifdef __FMA__
+  return std::fma(a, b, c);
+#else
+  return a * b + c;
+#endif
+}
+
 // Exact membership of sample k in the owned box (see KernelParams).
 // k may be fractional (a short chord's midpoint, see shortChord).
 inline bool inside(const KernelParams& p, const RaySetup& r, double k) {
   for (int a = 0; a < 3; ++a) {
-    const double u = r.origin[a] + k * r.step[a];
+    const double u = walkMulAdd(k, r.step[a], r.origin[a]);
     if (!(u >= p.ownLo[a])) return false;
     if (p.hiClosed[a] ? !(u <= p.ownHi[a]) : !(u < p.ownHi[a])) return false;
   }
@@ -424,7 +440,7 @@ struct ChordEnds {
 // Exact membership of sample k in the closed domain box [0, dims - 1].
 inline bool inDomain(const KernelParams& p, const RaySetup& r, std::int64_t k) {
   for (int a = 0; a < 3; ++a) {
-    const double u = r.origin[a] + double(k) * r.step[a];
+    const double u = walkMulAdd(double(k), r.step[a], r.origin[a]);
     if (!(u >= 0.0 && u <= double(p.domainMax[a]))) return false;
   }
   return true;
@@ -503,21 +519,6 @@ inline int octantOf(const RaySetup& r) { return directionOctant(r.step); }
 // (mix_kernel.cpp's chunk, and the least of castRay's).
 inline constexpr std::int64_t kVisibleChunk = 16;
 inline std::int64_t visibleChunk(const RaySetup& r) { return r.leapPerMacrocell >= 8 ? 2 * kVisibleChunk : kVisibleChunk; }
-
-// a * b + c for the walk's look-ups (pastEmpty, CubeExit::exit): rounded
-// once, as their lanes compute it (walk_lanes.h), wherever the CPU has
-// FMA. Written out, GCC's -ffp-contract=fast fuses it or not depending on
-// the code around it, so the same look-up rounded differently in different
-// callers (and a position a rounding away from a macrocell face landed in
-// the neighbouring macrocell).
-template <typename F>
-[[gnu::always_inline]] inline F walkMulAdd(F a, F b, F c) {
-#ifdef __FMA__
-  return std::fma(a, b, c);
-#else
-  return a * b + c;
-#endif
-}
 
 // The first sample at or after the ray leaves the cube of macrocells
 // within `distance - 1` of macrocell m (global index), never less than

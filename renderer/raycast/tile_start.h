@@ -118,6 +118,17 @@ inline bool clipToWalk(const KernelParams& p, const RaySetup& ray, const TileSpa
   return first <= last;
 }
 
+// Where a ray's walk through the brick starts and ends, as RayWalk::start
+// (cast_ray.h) finds it: the ray's samples in the brick (sampleRange),
+// those its walk looks at (clipToWalk) and the chord's ends (chordEnds of
+// first, last). startInLanes (start_lanes.h) finds the same for eight
+// rays at once.
+struct WalkStart {
+  std::int64_t first = 0, last = -1;  // the ray's samples in the brick
+  std::int64_t k = 0, end = -1;       // the first and last its walk looks at
+  ChordEnds ends;
+};
+
 // The span of rays[0, n), from marches of their fat ray through the
 // distance field inwards from both ends of where it crosses the visible
 // box (KernelParams::visibleLo): each ray may start its walk at `from` and

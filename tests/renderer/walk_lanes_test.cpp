@@ -12,23 +12,12 @@
 
 #include "raycast/cast_ray.h"
 #include "raycast/macrocells.h"
+#include "index_ray.h"
 
 #ifdef PVR_HAVE_WALK_LANES
 
 namespace pvr::core {
 namespace {
-
-// A ray in index space from its origin and step (invStep as raySetup
-// makes it: 0 where the step is 0).
-RaySetup rayOf(const double origin[3], const double step[3]) {
-  RaySetup r{};
-  for (int a = 0; a < 3; ++a) {
-    r.origin[a] = origin[a];
-    r.step[a] = step[a];
-    r.invStep[a] = step[a] != 0 ? 1.0 / step[a] : 0.0;
-  }
-  return r;
-}
 
 // Eight rays' look-ups at samples k[i], in lanes and one at a time.
 struct EightLook {
