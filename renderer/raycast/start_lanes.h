@@ -183,7 +183,8 @@ class StartLanes {
     // (lanes past n from rays[0]; their results are never read): the
     // first eight of those nine doubles of each ray by one load and a
     // transpose, the last by a gather (nine gathers were half of this
-    // function's time; ~20 % less of it so, bench/results/plain.txt 6).
+    // function's time; ~20 % less of it so: bench/results/plain.txt,
+    // section 7).
     static_assert(offsetof(RaySetup, step) == 3 * sizeof(double) && offsetof(RaySetup, invStep) == 6 * sizeof(double),
                   "origin, step and invStep lie side by side");
     __m512d rows[kStartLanes];
