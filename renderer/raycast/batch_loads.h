@@ -83,10 +83,11 @@ template <typename T>
 // Which is faster depends on the core, not on the code around it: on Intel
 // (Emerald Rapids) an eight-lane gather takes 1.64 ns in L1 and the
 // broadcasts made the peer scene's frame 7 % slower; AMD's Zen cores
-// microcode their gathers (Zen 5: ~10 ns for one, four a batch took more
-// than half the unshaded batch's time) and the broadcasts are the faster
-// (bench/results/plain.txt, section 6). -march=native tells us which core
-// this build is for.
+// microcode their gathers (Zen 5: ~10 ns for one; the instructions after a
+// batch's four gathers held about 40 % of the unshaded batch loop's
+// profile) and the broadcasts are the faster (bench/results/plain.txt,
+// section 6). -march=native tells us which core this build is for (GCC
+// defines __znverN__ for every Zen it knows; GCC 12 takes a Zen 5 as znver3).
 #if defined(__AVX512F__) && defined(__AVX512VL__) && \
     (defined(__znver1__) || defined(__znver2__) || defined(__znver3__) || defined(__znver4__) || defined(__znver5__))
 inline constexpr bool kBroadcastPairs = true;
