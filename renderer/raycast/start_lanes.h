@@ -103,7 +103,7 @@ struct Box {
   return in;
 }
 
-[[gnu::always_inline]] inline __m512d toDouble(__m512i k) { return _mm512_maskz_cvtepi64_pd(kAll, k); }
+[[gnu::always_inline]] inline __m512d asDouble(__m512i k) { return _mm512_maskz_cvtepi64_pd(kAll, k); }
 [[gnu::always_inline]] inline __m512i plus(__m512i k, std::int64_t d) { return _mm512_add_epi64(k, _mm512_set1_epi64(d)); }
 
 // The least member k >= 0 of the lanes' intervals of members, from the
@@ -115,7 +115,7 @@ struct Box {
 [[gnu::always_inline]] inline __m512i firstMember(__m512i c, const __m512d* o, const __m512d* s, const Box& box,
                                                   __mmask8& found) {
   __mmask8 in[3];
-  for (int j = 0; j < 3; ++j) in[j] = members(toDouble(plus(c, j - 1)), o, s, box);
+  for (int j = 0; j < 3; ++j) in[j] = members(asDouble(plus(c, j - 1)), o, s, box);
   in[0] &= _mm512_cmpge_epi64_mask(c, _mm512_set1_epi64(1));  // samples below 0 are no members
   found = __mmask8((in[1] | in[2]) & ~in[0]);
   return _mm512_mask_mov_epi64(plus(c, 1), in[1], c);
@@ -127,7 +127,7 @@ struct Box {
 [[gnu::always_inline]] inline __m512i lastMember(__m512i f, const __m512d* o, const __m512d* s, const Box& box,
                                                  __mmask8& found) {
   __mmask8 in[3];
-  for (int j = 0; j < 3; ++j) in[j] = members(toDouble(plus(f, j - 1)), o, s, box);
+  for (int j = 0; j < 3; ++j) in[j] = members(asDouble(plus(f, j - 1)), o, s, box);
   found = __mmask8((in[0] | in[1]) & ~in[2]);
   return _mm512_mask_mov_epi64(plus(f, -1), in[1], f);
 }
@@ -223,8 +223,8 @@ class StartLanes {
     if (const __mmask8 crossing = missed & chord & _mm512_cmp_pd_mask(kIn, far, _CMP_LT_OQ)) {
       const __m512i c = ceilToInt(kIn);
       // Samples max(0, c - 1) .. c + 1, c the entry's estimate.
-      __mmask8 sampled = members(toDouble(c), o, d, domain_) | members(toDouble(plus(c, 1)), o, d, domain_);
-      sampled |= members(toDouble(plus(c, -1)), o, d, domain_) & _mm512_cmpge_epi64_mask(c, _mm512_set1_epi64(1));
+      __mmask8 sampled = members(asDouble(c), o, d, domain_) | members(asDouble(plus(c, 1)), o, d, domain_);
+      sampled |= members(asDouble(plus(c, -1)), o, d, domain_) & _mm512_cmpge_epi64_mask(c, _mm512_set1_epi64(1));
       const __m512d mid = _mm512_maskz_mul_pd(kAll, _mm512_set1_pd(0.5), _mm512_maskz_add_pd(kAll, kIn, kOut));
       none |= crossing & (sampled | __mmask8(~members(mid, o, d, owned_)));
     }
@@ -249,7 +249,8 @@ class StartLanes {
     s.scalar = __mmask8(~none & ~s.hit);
 
     // clipToVisible, then clipToWalk's span.
-    __m512d vmin = toDouble(first), vmax = toDouble(last);
+    const __m512d firstD = asDouble(first);
+    __m512d vmin = firstD, vmax = asDouble(last);
     __mmask8 walks = s.hit;
     if (nothingVisible_) walks = 0;
     walks &= __mmask8(~clip(o, d, inv, visible_, vmin, vmax)) & _mm512_cmp_pd_mask(vmin, vmax, _CMP_LE_OQ);
@@ -260,7 +261,6 @@ class StartLanes {
     // chordEnds: its ends are the domain's first member >= 0 and its last
     // (whatever its estimates; see ChordEnds), which are the owned box's
     // when the brick owns the domain.
-    const __m512d firstD = toDouble(first);
     kIn = _mm512_mask_blend_pd(chord, firstD, kIn);
     kOut = _mm512_mask_blend_pd(chord, firstD, kOut);
     __m512i endsFirst = first, endsLast = last;
@@ -274,8 +274,8 @@ class StartLanes {
       s.hit &= ~s.scalar;
     }
     s.walks = walks;
-    const __m512d head = clampUnit(_mm512_maskz_sub_pd(kAll, toDouble(endsFirst), kIn));
-    const __m512d tail = clampUnit(_mm512_maskz_sub_pd(kAll, kOut, toDouble(endsLast)));
+    const __m512d head = clampUnit(_mm512_maskz_sub_pd(kAll, asDouble(endsFirst), kIn));
+    const __m512d tail = clampUnit(_mm512_maskz_sub_pd(kAll, kOut, asDouble(endsLast)));
     _mm512_store_si512(s.first, first);
     _mm512_store_si512(s.last, last);
     _mm512_store_si512(s.k, k);
