@@ -384,5 +384,11 @@ TEST_CASE("prefetchBox brings in all of a box larger than the kernel's read-ahea
   const auto source = openVolumeFile(sidecar);
   source->prefetchBox(grid.allNodes());
   const std::vector<bool> after = residentOnce(raw, 0, residentPages(raw).size());
-  CHECK(std::count(after.begin(), after.end(), false) == 0);
+  // Read-ahead is a hint the kernel may drop in part: it allocates those
+  // pages without retrying, so under memory pressure (the whole suite in
+  // parallel) a few of them stay out (11 of 8192 once). The fault this
+  // guards against left three quarters out; allow 1 %.
+  const auto missing = std::count(after.begin(), after.end(), false);
+  INFO(missing << " of " << after.size() << " pages not resident");
+  CHECK(missing * 100 <= std::ptrdiff_t(after.size()));
 }
