@@ -74,10 +74,23 @@ inline int blockLevel(const KernelParams& p, const RaySetup& ray, const ChordEnd
 // blocks made chunks of 4-8 samples there, each paying a chunk's start and a
 // part batch; and at those levels a coarse sample across an empty
 // macrocell costs less than the leap's look-up (~24 ns, bench/results/
-// walk.txt). With 16 (chunks still end at kVisibleChunk samples): one
+// walk.txt). With 16 (chunks then ended at kVisibleChunk samples): one
 // thread, peer scene at target 40 dB 282 -> 228 ms a frame, CT head at
 // 50 dB 370-415 -> 355-372 ms, same images.
 inline constexpr std::int64_t kBlocksPerChunk = 16;
+
+// Samples a chunk takes per look-up: at level 0 a uniform walk's
+// (visibleChunk(), 32 at half-voxel steps), at coarser levels up to 64
+// coarse samples. Each chunk leaves the batch loop and enters it again
+// (its setup, and a first batch fetched with nothing to overlap it), and
+// at a coarse step a sample run on into an empty macrocell costs less than
+// a look-up. Against 16 of each, one thread alternating (load 1.0-1.4):
+// peer scene at 40 dB 151.5 -> 141 ms a frame (medians of 7), CT head at
+// 50 dB 341 -> 295 ms (faster in 6 of 6 rounds); samples run into empty
+// space add 2-7 % to the samples and move no PSNR of
+// bench/results/quality.txt by 0.01 dB (the batches' float grouping
+// changes by an ulp). bench/results/plain.txt, section 8.
+inline constexpr std::int64_t kCoarseChunk = 4 * kVisibleChunk;
 
 }  // namespace kernel
 
@@ -106,6 +119,7 @@ RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShif
   const kernel::CubeExit cube(ray, mcShift);
   const std::uint8_t* field = p.leapField[kernel::octantOf(ray)];
   kernel::Accumulator acc;
+  const std::int64_t fineChunk = kernel::visibleChunk(ray);
   while (k <= end) {  // k: the next fine sample not yet covered or skipped
     // Empty space is skipped as castRay skips it: a coarse sample in
     // skipped space is transparent too.
@@ -116,7 +130,7 @@ RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShif
     const std::int64_t block = k >> kLevelBlockShift, blockEnd = (block + 1) << kLevelBlockShift;
     const int level = kernel::blockLevel(p, ray, ends, block);
     if (level == 0) {
-      std::int64_t exit = std::min(end + 1, k + kernel::kVisibleChunk);
+      std::int64_t exit = std::min(end + 1, k + fineChunk);
       if (exit > blockEnd && kernel::blockLevel(p, ray, ends, block + 1) != 0) exit = blockEnd;
       if (kernel::runSpan<T, kShaded, false>(p, ray, ends, k, exit, acc, out.samples)) break;
       k = exit;
@@ -132,11 +146,11 @@ RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShif
     const std::int64_t start = kernel::coarseFrom(k, level);
     std::int64_t runEnd = blockEnd;
     while (runEnd <= end && runEnd - blockEnd < (kernel::kBlocksPerChunk - 1) * kLevelBlock &&
-           (runEnd >> level) - start < kernel::kVisibleChunk &&
+           (runEnd >> level) - start < kernel::kCoarseChunk &&
            kernel::blockLevel(p, ray, ends, runEnd >> kLevelBlockShift) == level)
       runEnd += kLevelBlock;
     const std::int64_t exit =
-        std::min({kernel::coarseFrom(end + 1, level), runEnd >> level, start + kernel::kVisibleChunk});
+        std::min({kernel::coarseFrom(end + 1, level), runEnd >> level, start + kernel::kCoarseChunk});
     if (start < exit &&
         kernel::runSpan<T, kShaded, false>(p.atLevel[level], coarse[level], noEnds, start, exit, acc, out.samples))
       break;
