@@ -16,6 +16,8 @@
 //
 // Per chunk, not per sample: one level look-up chooses the parameters and
 // the ray a chunk is marched with; runSpan marches it as castRay does.
+// Sixteen rays are started and walked past empty space at once, as
+// castRays' are (LevelWalk, castRaysByLevels).
 #pragma once
 
 #include "cast_ray.h"
@@ -92,72 +94,166 @@ inline constexpr std::int64_t kBlocksPerChunk = 16;
 // changes by an ulp). bench/results/plain.txt, section 8.
 inline constexpr std::int64_t kCoarseChunk = 4 * kVisibleChunk;
 
-}  // namespace kernel
-
-// One ray; its samples outside `span` lie in invisible macrocells
-// (tileSpan(), tile_start.h; by default nothing is known).
+// One ray's march by levels, a step at a time, with RayWalk's interface,
+// so that the vector lanes start rays and take their look-ups past empty
+// space for it (startInLanes, walkInLanes), sixteen rays at once, as
+// castRays does: one ray at a time, the march's own scalar look-ups were a
+// third of a peer frame at 40 dB (bench/results/plain.txt, section 8).
+// Each ray takes the look-ups, leaps and chunks of the loop one ray at a
+// time took, in the same order: the same samples and bits.
 template <typename T, bool kShaded>
-RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShift,
-                          const kernel::TileSpan& span = {}) {
-  std::int64_t first, last;
-  if (!kernel::sampleRange(p, ray, first, last)) return castRay<T, kShaded, false>(p, ray, mcShift);
-  RayResult out;
-  out.hit = true;
-  // The march starts and ends where castRay's walk does (the visible box,
-  // the tile's span): the samples outside are in invisible macrocells,
-  // transparent at every level as the empty space skipped below is.
-  std::int64_t k = first, end = last;
-  if (!kernel::clipToWalk(p, ray, span, k, end)) return out;
-  const kernel::ChordEnds ends = kernel::chordEnds(p, ray, first, last);
-  // A coarse chunk has no chord end in it (blockLevel).
-  const kernel::ChordEnds noEnds{-1, std::numeric_limits<std::int64_t>::max(), 0, 0};
-  RaySetup coarse[kStepLevels];
-  bool coarseSet[kStepLevels] = {};
+class LevelWalk {
+ public:
+  // Sets the march up; false when the ray is done already (out holds its
+  // result). The ray's samples outside `span` lie in invisible macrocells
+  // (tileSpan(), tile_start.h).
+  bool start(const KernelParams& p, const RaySetup& ray, int mcShift, const TileSpan& span, RayResult& out) {
+    WalkStart at;
+    if (!sampleRange(p, ray, at.first, at.last)) {
+      out = castRay<T, kShaded, false>(p, ray, mcShift);
+      return false;
+    }
+    out.hit = true;
+    // The march starts and ends where castRay's walk does (the visible box,
+    // the tile's span): the samples outside are in invisible macrocells,
+    // transparent at every level as the empty space skipped is.
+    at.k = at.first;
+    at.end = at.last;
+    if (!clipToWalk(p, ray, span, at.k, at.end)) return false;
+    at.ends = chordEnds(p, ray, at.first, at.last);
+    begin(p, ray, mcShift, at);
+    return k_ <= end_ || finish(out);
+  }
 
-  const float o[3] = {float(ray.origin[0]), float(ray.origin[1]), float(ray.origin[2])};
-  const float d[3] = {float(ray.step[0]), float(ray.step[1]), float(ray.step[2])};
-  const kernel::CubeExit cube(ray, mcShift);
-  const std::uint8_t* field = p.leapField[kernel::octantOf(ray)];
-  kernel::Accumulator acc;
-  const std::int64_t fineChunk = kernel::visibleChunk(ray);
-  while (k <= end) {  // k: the next fine sample not yet covered or skipped
+  // Sets the march up from where it starts (start(), or startInLanes,
+  // which finds the same as RayWalk::start for eight rays at once).
+  void begin(const KernelParams& p, const RaySetup& ray, int mcShift, const WalkStart& at) {
+    k_ = at.k;
+    end_ = at.end;
+    ends_ = at.ends;
+    for (int a = 0; a < 3; ++a) {
+      o_[a] = float(ray.origin[a]);
+      d_[a] = float(ray.step[a]);
+    }
+    cube_ = CubeExit(ray, mcShift);
+    field_ = p.leapField[octantOf(ray)];
+    fineChunk_ = visibleChunk(ray);
+  }
+
+  // One look-up past empty space, or one chunk; false when the ray is done
+  // (out holds its result).
+  bool step(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
     // Empty space is skipped as castRay skips it: a coarse sample in
     // skipped space is transparent too.
-    if (const std::int64_t next = kernel::pastEmpty(p, field, cube, o, d, k, mcShift); next != k) {
-      k = next;
-      continue;
+    if (const std::int64_t next = pastEmpty(p, field_, cube_, o_, d_, k_, mcShift); next != k_) {
+      k_ = next;
+      return k_ <= end_ || finish(out);
     }
-    const std::int64_t block = k >> kLevelBlockShift, blockEnd = (block + 1) << kLevelBlockShift;
-    const int level = kernel::blockLevel(p, ray, ends, block);
+    return chunkAt(k_, p, ray, mcShift, out);
+  }
+
+  // step() after a look-up that found fine sample k's macrocell visible:
+  // a chunk at the level of k's block.
+  bool chunkAt(std::int64_t k, const KernelParams& p, const RaySetup& ray, int /*mcShift*/, RayResult& out) {
+    k_ = k;
+    const std::int64_t block = k_ >> kLevelBlockShift, blockEnd = (block + 1) << kLevelBlockShift;
+    const int level = blockLevel(p, ray, ends_, block);
     if (level == 0) {
-      std::int64_t exit = std::min(end + 1, k + fineChunk);
-      if (exit > blockEnd && kernel::blockLevel(p, ray, ends, block + 1) != 0) exit = blockEnd;
-      if (kernel::runSpan<T, kShaded, false>(p, ray, ends, k, exit, acc, out.samples)) break;
-      k = exit;
-      continue;
+      std::int64_t exit = std::min(end_ + 1, k_ + fineChunk_);
+      if (exit > blockEnd && blockLevel(p, ray, ends_, block + 1) != 0) exit = blockEnd;
+      if (runSpan<T, kShaded, false>(p, ray, ends_, k_, exit, acc_, out.samples)) return finish(out);
+      k_ = exit;
+      return k_ <= end_ || finish(out);
     }
-    if (!coarseSet[level]) {
-      coarse[level] = kernel::levelRay(ray, level);
-      coarseSet[level] = true;
+    if (!(coarseSet_ & (1u << level))) {
+      coarse_[level] = levelRay(ray, level);
+      coarseSet_ |= 1u << level;
     }
     // The block's coarse samples from k on that this brick owns (theirs
     // are fine samples in [k, end]), with those of the next blocks of the
     // same level, a chunk at a time.
-    const std::int64_t start = kernel::coarseFrom(k, level);
+    const std::int64_t start = coarseFrom(k_, level);
     std::int64_t runEnd = blockEnd;
-    while (runEnd <= end && runEnd - blockEnd < (kernel::kBlocksPerChunk - 1) * kLevelBlock &&
-           (runEnd >> level) - start < kernel::kCoarseChunk &&
-           kernel::blockLevel(p, ray, ends, runEnd >> kLevelBlockShift) == level)
+    while (runEnd <= end_ && runEnd - blockEnd < (kBlocksPerChunk - 1) * kLevelBlock &&
+           (runEnd >> level) - start < kCoarseChunk && blockLevel(p, ray, ends_, runEnd >> kLevelBlockShift) == level)
       runEnd += kLevelBlock;
-    const std::int64_t exit =
-        std::min({kernel::coarseFrom(end + 1, level), runEnd >> level, start + kernel::kCoarseChunk});
-    if (start < exit &&
-        kernel::runSpan<T, kShaded, false>(p.atLevel[level], coarse[level], noEnds, start, exit, acc, out.samples))
-      break;
-    k = std::min(runEnd, std::max(k + 1, kernel::fineOf(exit, level)));
+    const std::int64_t exit = std::min({coarseFrom(end_ + 1, level), runEnd >> level, start + kCoarseChunk});
+    // A coarse chunk has no chord end in it (blockLevel).
+    const ChordEnds noEnds{-1, std::numeric_limits<std::int64_t>::max(), 0, 0};
+    if (start < exit && runSpan<T, kShaded, false>(p.atLevel[level], coarse_[level], noEnds, start, exit, acc_,
+                                                   out.samples))
+      return finish(out);
+    k_ = std::min(runEnd, std::max(k_ + 1, fineOf(exit, level)));
+    return k_ <= end_ || finish(out);
   }
-  out.colour = acc.rgba();
+
+  bool finish(RayResult& out) const {
+    out.colour = acc_.rgba();
+    return false;
+  }
+
+  // The fine sample the march looks at next.
+  std::int64_t at() const { return k_; }
+  // Lane i of `lanes` takes this march's look-ups (walkInLanes).
+  template <typename Lanes>
+  void toLane(Lanes& lanes, int i) const {
+    lanes.set(i, o_, d_, cube_, field_, k_, end_);
+  }
+
+ private:
+  std::int64_t k_ = 0, end_ = -1;  // the next fine sample not yet covered or skipped; the last in the visible box
+  std::int64_t fineChunk_ = 0;     // samples of a level-0 chunk
+  ChordEnds ends_;
+  CubeExit cube_;
+  const std::uint8_t* field_ = nullptr;  // the distance field this ray leaps by (pastEmpty)
+  float o_[3], d_[3];                    // the ray's origin and step in float, as the samples'
+  RaySetup coarse_[kStepLevels];         // the ray at level l, once a chunk of that level needs it
+  unsigned coarseSet_ = 0;               // bit l: coarse_[l] is set
+  Accumulator acc_;
+};
+
+}  // namespace kernel
+
+// One ray marched by levels; its samples outside `span` lie in invisible
+// macrocells (tileSpan(), tile_start.h; by default nothing is known).
+template <typename T, bool kShaded>
+RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShift,
+                          const kernel::TileSpan& span = {}) {
+  RayResult out;
+  kernel::LevelWalk<T, kShaded> walk;
+  if (walk.start(p, ray, mcShift, span, out))
+    while (walk.step(p, ray, mcShift, out)) {
+    }
   return out;
+}
+
+// Rays rays[0, n) into out[0, n), n <= kRaysAtOnce, each as
+// castRayByLevels would take it (with the same `span`): started and walked
+// in vector lanes where the CPU has AVX-512 (start_lanes.h, walk_lanes.h),
+// else their steps by turns.
+template <typename T, bool kShaded>
+void castRaysByLevels(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan& span,
+                      RayResult* out) {
+  kernel::LevelWalk<T, kShaded> walk[kRaysAtOnce];
+  bool going[kRaysAtOnce];
+#ifdef PVR_HAVE_WALK_LANES
+  const int left = kernel::startInLanes(p, rays, n, mcShift, span, walk, going, out);
+  if (left > 0) kernel::walkInLanes(p, rays, n, mcShift, walk, going, out);
+#else
+  int left = 0;
+  for (int i = 0; i < n; ++i) {
+    out[i] = RayResult{};
+    going[i] = walk[i].start(p, rays[i], mcShift, span, out[i]);
+    left += going[i];
+  }
+  while (left > 0) {
+    for (int i = 0; i < n; ++i) {
+      if (!going[i]) continue;
+      going[i] = walk[i].step(p, rays[i], mcShift, out[i]);
+      left -= !going[i];
+    }
+  }
+#endif
 }
 
 }  // namespace pvr::core

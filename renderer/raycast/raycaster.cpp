@@ -37,13 +37,6 @@ RayFunction pickKernel(bool shaded, bool preintegrated, int powerBits) {
   return powerBits <= 6 ? &castRays<T, true, false, 6> : &castRays<T, true, false, kernel::kPowerBits>;
 }
 
-// A kernel of one ray at a time as a RayFunction.
-template <RayResult (*kCast)(const KernelParams&, const RaySetup&, int, const kernel::TileSpan&)>
-void oneByOne(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan& span,
-              RayResult* out) {
-  for (int i = 0; i < n; ++i) out[i] = kCast(p, rays[i], mcShift, span);
-}
-
 RayFunction pickKernel(ScalarType type, bool shaded, bool preintegrated, int powerBits) {
   return dispatchScalar(type, [&](auto tag) {
     using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
@@ -55,7 +48,7 @@ RayFunction pickKernel(ScalarType type, bool shaded, bool preintegrated, int pow
 RayFunction pickLevelKernel(ScalarType type, bool shaded) {
   return dispatchScalar(type, [&](auto tag) -> RayFunction {
     using T = std::remove_const_t<std::remove_pointer_t<decltype(tag)>>;
-    return shaded ? &oneByOne<&castRayByLevels<T, true>> : &oneByOne<&castRayByLevels<T, false>>;
+    return shaded ? &castRaysByLevels<T, true> : &castRaysByLevels<T, false>;
   });
 }
 

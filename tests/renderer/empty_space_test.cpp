@@ -537,10 +537,11 @@ TEST_CASE("a tile's rays walk only where one of them can meet a visible macrocel
 // Quality chosen by error (castRayByLevels) walks only the tile's span as
 // castRay does: the same colours as without the span to the last bit; and
 // a span cut short ends the rays there (the span is used, not just
-// computed).
+// computed). castRaysByLevels, sixteen rays started and walked at once,
+// draws each ray as castRayByLevels does, to the last bit and sample.
 // The blob between empty space, seen so that the rays cross empty space
 // before and behind it; shaded and not, at a target that mixes levels.
-TEST_CASE("the step chosen per region walks only the tile's span and draws the same rays", "[raycast][levels]") {
+TEST_CASE("the step chosen per region walks only the tile's span and draws the same rays, one at a time or sixteen at once", "[raycast][levels]") {
   const Brick volume = blobAndSpeckVolume();
   const std::vector<Camera> views = {
       makeCamera(Projection::kPerspective, {-120, -100, -80}, {70, 66, 72}, {0, 0, 1}, 12, 48, 48),
@@ -573,8 +574,22 @@ TEST_CASE("the step chosen per region walks only the tile's span and draws the s
         for (int tx = 0; tx < camera.width(); tx += 16) {
           const std::vector<RaySetup> rays = tileRays(camera, tx, ty, volume.grid(), fine);
           const kernel::TileSpan span = kernel::tileSpan(p, rays.data(), int(rays.size()), kShift);
+          // The tile's rows as the renderer takes them: kRaysAtOnce rays at
+          // once (in vector lanes where the CPU has AVX-512).
+          std::vector<RayResult> atOnce(rays.size());
+          for (std::size_t i = 0; i < rays.size(); i += kRaysAtOnce) {
+            const int n = int(std::min<std::size_t>(kRaysAtOnce, rays.size() - i));
+            (shaded ? &castRaysByLevels<std::uint8_t, true> : &castRaysByLevels<std::uint8_t, false>)(
+                p, &rays[i], n, kShift, span, &atOnce[i]);
+          }
           for (std::size_t i = 0; i < rays.size(); ++i) {
             const RayResult with = cast(p, rays[i], kShift, span), without = cast(p, rays[i], kShift, {});
+            CHECK(atOnce[i].colour.r == with.colour.r);
+            CHECK(atOnce[i].colour.g == with.colour.g);
+            CHECK(atOnce[i].colour.b == with.colour.b);
+            CHECK(atOnce[i].colour.a == with.colour.a);
+            CHECK(atOnce[i].samples == with.samples);
+            CHECK(atOnce[i].hit == with.hit);
             const RayResult cut = cast(p, rays[i], kShift, {span.from, span.from + (span.to - span.from) / 4});
             INFO("shaded " << shaded << " view " << v << " tile " << tx << ", " << ty << " ray " << i);
             CHECK(with.colour.r == without.colour.r);
