@@ -216,6 +216,14 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
 
 namespace kernel {
 
+// The ray's origin and step in float, as its samples' positions take them.
+inline void floatRay(const RaySetup& ray, float o[3], float d[3]) {
+  for (int a = 0; a < 3; ++a) {
+    o[a] = float(ray.origin[a]);
+    d[a] = float(ray.step[a]);
+  }
+}
+
 // One ray's walk through the brick, a look-up at a time: castRay takes
 // one ray's steps in turn; castRays takes the steps of several rays by
 // turns, so that their chains of dependent arithmetic and loads a look-up
@@ -262,10 +270,7 @@ class RayWalk {
     k_ = at.k;
     end_ = at.end;
     ends_ = at.ends;
-    for (int a = 0; a < 3; ++a) {
-      o_[a] = float(ray.origin[a]);
-      d_[a] = float(ray.step[a]);
-    }
+    floatRay(ray, o_, d_);
     done_ = first_;
     leapFrom_ = std::numeric_limits<std::int64_t>::min();
     chunk_ = visibleChunk(ray);
@@ -361,33 +366,31 @@ class RayWalk {
   Accumulator acc_;
 };
 
-}  // namespace kernel
-
-// One ray; its samples outside `span` lie in invisible macrocells
-// (tileSpan(), tile_start.h; by default nothing is known).
-template <typename T, bool kShaded, bool kPreintegrated, int kPower = kernel::kTablePower>
-RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift, const kernel::TileSpan& span = {}) {
+// One ray by a Walk (RayWalk, or cast_ray_levels.h's LevelWalk): its
+// steps in turn.
+template <typename Walk>
+RayResult castWalk(const KernelParams& p, const RaySetup& ray, int mcShift, const TileSpan& span) {
   RayResult out;
-  kernel::RayWalk<T, kShaded, kPreintegrated, kPower> walk;
+  Walk walk;
   if (walk.start(p, ray, mcShift, span, out))
     while (walk.step(p, ray, mcShift, out)) {
     }
   return out;
 }
 
-// Rays rays[0, n) into out[0, n), n <= kRaysAtOnce, each as castRay
+// Rays rays[0, n) into out[0, n), n <= kRaysAtOnce, each as castWalk
 // would take it (with the same `span`): their walks by turns, a step of
-// each (see RayWalk), with the look-ups of all of them in the lanes of one
-// vector where the CPU has AVX-512 (walk_lanes.h), and their starts
-// there eight at once too (start_lanes.h).
-template <typename T, bool kShaded, bool kPreintegrated, int kPower = kernel::kTablePower>
-void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan& span,
-              RayResult* out) {
-  kernel::RayWalk<T, kShaded, kPreintegrated, kPower> walk[kRaysAtOnce];
+// each, with the look-ups of all of them in the lanes of one vector where
+// the CPU has AVX-512 (walk_lanes.h), and their starts there eight at once
+// too (start_lanes.h).
+template <typename Walk>
+void castWalks(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const TileSpan& span,
+               RayResult* out) {
+  Walk walk[kRaysAtOnce];
   bool going[kRaysAtOnce];
 #ifdef PVR_HAVE_WALK_LANES
-  const int left = kernel::startInLanes(p, rays, n, mcShift, span, walk, going, out);
-  if (left > 0) kernel::walkInLanes(p, rays, n, mcShift, walk, going, out);
+  const int left = startInLanes(p, rays, n, mcShift, span, walk, going, out);
+  if (left > 0) walkInLanes(p, rays, n, mcShift, walk, going, out);
 #else
   int left = 0;
   for (int i = 0; i < n; ++i) {
@@ -403,6 +406,23 @@ void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, c
     }
   }
 #endif
+}
+
+}  // namespace kernel
+
+// One ray; its samples outside `span` lie in invisible macrocells
+// (tileSpan(), tile_start.h; by default nothing is known).
+template <typename T, bool kShaded, bool kPreintegrated, int kPower = kernel::kTablePower>
+RayResult castRay(const KernelParams& p, const RaySetup& ray, int mcShift, const kernel::TileSpan& span = {}) {
+  return kernel::castWalk<kernel::RayWalk<T, kShaded, kPreintegrated, kPower>>(p, ray, mcShift, span);
+}
+
+// Rays rays[0, n) into out[0, n), n <= kRaysAtOnce, each as castRay
+// would take it (with the same `span`), several at once (castWalks).
+template <typename T, bool kShaded, bool kPreintegrated, int kPower = kernel::kTablePower>
+void castRays(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan& span,
+              RayResult* out) {
+  kernel::castWalks<kernel::RayWalk<T, kShaded, kPreintegrated, kPower>>(p, rays, n, mcShift, span, out);
 }
 
 }  // namespace pvr::core

@@ -131,10 +131,7 @@ class LevelWalk {
     k_ = at.k;
     end_ = at.end;
     ends_ = at.ends;
-    for (int a = 0; a < 3; ++a) {
-      o_[a] = float(ray.origin[a]);
-      d_[a] = float(ray.step[a]);
-    }
+    floatRay(ray, o_, d_);
     cube_ = CubeExit(ray, mcShift);
     field_ = p.leapField[octantOf(ray)];
     fineChunk_ = visibleChunk(ray);
@@ -219,41 +216,16 @@ class LevelWalk {
 template <typename T, bool kShaded>
 RayResult castRayByLevels(const KernelParams& p, const RaySetup& ray, int mcShift,
                           const kernel::TileSpan& span = {}) {
-  RayResult out;
-  kernel::LevelWalk<T, kShaded> walk;
-  if (walk.start(p, ray, mcShift, span, out))
-    while (walk.step(p, ray, mcShift, out)) {
-    }
-  return out;
+  return kernel::castWalk<kernel::LevelWalk<T, kShaded>>(p, ray, mcShift, span);
 }
 
 // Rays rays[0, n) into out[0, n), n <= kRaysAtOnce, each as
-// castRayByLevels would take it (with the same `span`): started and walked
-// in vector lanes where the CPU has AVX-512 (start_lanes.h, walk_lanes.h),
-// else their steps by turns.
+// castRayByLevels would take it (with the same `span`), sixteen at once in
+// vector lanes where the CPU has AVX-512 (castWalks).
 template <typename T, bool kShaded>
 void castRaysByLevels(const KernelParams& p, const RaySetup* rays, int n, int mcShift, const kernel::TileSpan& span,
                       RayResult* out) {
-  kernel::LevelWalk<T, kShaded> walk[kRaysAtOnce];
-  bool going[kRaysAtOnce];
-#ifdef PVR_HAVE_WALK_LANES
-  const int left = kernel::startInLanes(p, rays, n, mcShift, span, walk, going, out);
-  if (left > 0) kernel::walkInLanes(p, rays, n, mcShift, walk, going, out);
-#else
-  int left = 0;
-  for (int i = 0; i < n; ++i) {
-    out[i] = RayResult{};
-    going[i] = walk[i].start(p, rays[i], mcShift, span, out[i]);
-    left += going[i];
-  }
-  while (left > 0) {
-    for (int i = 0; i < n; ++i) {
-      if (!going[i]) continue;
-      going[i] = walk[i].step(p, rays[i], mcShift, out[i]);
-      left -= !going[i];
-    }
-  }
-#endif
+  kernel::castWalks<kernel::LevelWalk<T, kShaded>>(p, rays, n, mcShift, span, out);
 }
 
 }  // namespace pvr::core
