@@ -255,9 +255,8 @@ class RayWalk {
     out.hit = true;
     // The walk starts and ends at the visible box; a ray that misses it
     // costs nothing more.
-    WalkStart at{first_, last_, first_, last_, {}};
-    if (!clipToWalk(p, ray, span, at.k, at.end)) return false;
-    at.ends = chordEnds(p, ray, first_, last_);
+    WalkStart at;
+    if (!walkStart(p, ray, span, first_, last_, at)) return false;
     begin(p, ray, mcShift, at);
     return true;
   }

@@ -108,8 +108,8 @@ class LevelWalk {
   // result). The ray's samples outside `span` lie in invisible macrocells
   // (tileSpan(), tile_start.h).
   bool start(const KernelParams& p, const RaySetup& ray, int mcShift, const TileSpan& span, RayResult& out) {
-    WalkStart at;
-    if (!sampleRange(p, ray, at.first, at.last)) {
+    std::int64_t first, last;
+    if (!sampleRange(p, ray, first, last)) {
       out = castRay<T, kShaded, false>(p, ray, mcShift);
       return false;
     }
@@ -117,12 +117,10 @@ class LevelWalk {
     // The march starts and ends where castRay's walk does (the visible box,
     // the tile's span): the samples outside are in invisible macrocells,
     // transparent at every level as the empty space skipped is.
-    at.k = at.first;
-    at.end = at.last;
-    if (!clipToWalk(p, ray, span, at.k, at.end)) return false;
-    at.ends = chordEnds(p, ray, at.first, at.last);
+    WalkStart at;
+    if (!walkStart(p, ray, span, first, last, at)) return false;
     begin(p, ray, mcShift, at);
-    return k_ <= end_ || finish(out);
+    return true;
   }
 
   // Sets the march up from where it starts (start(), or startInLanes,

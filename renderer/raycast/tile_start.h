@@ -118,8 +118,8 @@ inline bool clipToWalk(const KernelParams& p, const RaySetup& ray, const TileSpa
   return first <= last;
 }
 
-// Where a ray's walk through the brick starts and ends, as RayWalk::start
-// (cast_ray.h) finds it: the ray's samples in the brick (sampleRange),
+// Where a ray's walk through the brick starts and ends (walkStart below,
+// for RayWalk and LevelWalk): the ray's samples in the brick (sampleRange),
 // those its walk looks at (clipToWalk) and the chord's ends (chordEnds of
 // first, last). startInLanes (start_lanes.h) finds the same for eight
 // rays at once.
@@ -128,6 +128,17 @@ struct WalkStart {
   std::int64_t k = 0, end = -1;       // the first and last its walk looks at
   ChordEnds ends;
 };
+
+// The WalkStart of a ray whose samples in the brick are [first, last]
+// (sampleRange); false when its walk looks at nothing (it misses the
+// visible box or the tile's span).
+inline bool walkStart(const KernelParams& p, const RaySetup& ray, const TileSpan& span, std::int64_t first,
+                      std::int64_t last, WalkStart& at) {
+  at = {first, last, first, last, {}};
+  if (!clipToWalk(p, ray, span, at.k, at.end)) return false;
+  at.ends = chordEnds(p, ray, first, last);
+  return true;
+}
 
 // The span of rays[0, n), from marches of their fat ray through the
 // distance field inwards from both ends of where it crosses the visible
