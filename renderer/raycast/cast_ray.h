@@ -136,9 +136,10 @@ struct NoChunks {
 
 // Samples [start, exit) of a visible run: the chord's end samples by
 // runEnd, the others in one loop. Returns true at early termination.
-// `chunks` (plain kernels): where the batches end exactly at `exit`, the
-// walk's next chunk follows on in the same loop when it starts at `exit`
-// and holds a whole batch before the chord's last sample.
+// `chunks`: where the batches reach `exit`, the walk's next chunk follows
+// on in the same loop when it starts at `exit` and holds a whole batch
+// before the chord's last sample (plain batches ending exactly at `exit`;
+// pre-integrated ones also from a partial batch).
 template <typename T, bool kShaded, bool kPreintegrated, int kPower = kTablePower, typename Chunks = NoChunks>
 inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds& ends,
                     std::int64_t start, std::int64_t exit, Accumulator& acc, std::uint64_t& samples,
@@ -166,19 +167,19 @@ inline bool runSpan(const KernelParams& p, const RaySetup& ray, const ChordEnds&
   if (start < body) {
 #ifdef PVR_HAVE_BATCH_KERNEL
     if (p.indices32) {
+      // The follow-on chunk's samples after the chord's last one are
+      // taken where the walk would take them: by runEnd, below.
+      auto more = [&](std::int64_t at) __attribute__((always_inline)) {
+        const std::int64_t next = chunks.next(at);
+        if (std::min(next, ends.last) < at + 8) return at;
+        chunks.take(next);
+        exit = next;
+        body = std::min(next, ends.last);
+        return body;
+      };
       if constexpr (kPreintegrated) {
-        if (runBatchedPreintegrated<T, kShaded>(p, ray, start, body, acc, samples)) return true;
+        if (runBatchedPreintegrated<T, kShaded>(p, ray, start, body, acc, samples, more)) return true;
       } else {
-        // The follow-on chunk's samples after the chord's last one are
-        // taken where the walk would take them: by runEnd, below.
-        auto more = [&](std::int64_t at) __attribute__((always_inline)) {
-          const std::int64_t next = chunks.next(at);
-          if (std::min(next, ends.last) < at + 8) return at;
-          chunks.take(next);
-          exit = next;
-          body = std::min(next, ends.last);
-          return body;
-        };
         if (runBatched<T, kShaded, kPower>(p, ray, start, body, acc, samples, more)) return true;
       }
     }
