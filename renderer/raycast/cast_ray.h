@@ -225,13 +225,76 @@ inline void floatRay(const RaySetup& ray, float o[3], float d[3]) {
   }
 }
 
+// What RayWalk and LevelWalk share: where the walk is (sample k_, to the
+// last sample in the visible box end_, and the chord's ends), how it leaps
+// past empty space (pastEmpty: the ray's float origin and step, its cube
+// exit and distance field), the colour so far, and the step that is a
+// look-up past empty space or, where the look-up finds sample k's
+// macrocell visible, the walk's own chunk there (Walk::chunkAt(k, ...)).
+// walkInLanes makes the look-ups of sixteen walks in vector lanes (toLane)
+// and calls chunkAt() and finish() itself.
+template <typename Walk>
+class LeapingWalk {
+ public:
+  // One look-up, and a chunk of samples where it finds something visible.
+  // False when the ray is done (out holds its result).
+  bool step(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
+    if (const std::int64_t next = pastEmpty(p, field_, cube_, o_, d_, k_, mcShift); next != k_) {
+      k_ = next;
+      return k_ <= end_ || finish(out);
+    }
+    return static_cast<Walk&>(*this).chunkAt(k_, p, ray, mcShift, out);
+  }
+
+  bool finish(RayResult& out) const {
+    out.colour = acc_.rgba();
+    return false;
+  }
+
+  // The sample the walk looks at next.
+  std::int64_t at() const { return k_; }
+  // Lane i of `lanes` takes this walk's look-ups (walkInLanes).
+  template <typename Lanes>
+  void toLane(Lanes& lanes, int i) const {
+    lanes.set(i, o_, d_, cube_, field_, k_, end_);
+  }
+
+ protected:
+  void beginAt(const KernelParams& p, const RaySetup& ray, int mcShift, const WalkStart& at) {
+    k_ = at.k;
+    end_ = at.end;
+    ends_ = at.ends;
+    floatRay(ray, o_, d_);
+    cube_ = CubeExit(ray, mcShift);
+    field_ = p.leapField[octantOf(ray)];
+  }
+  // Where the walk goes on from sample k (pastEmpty).
+  std::int64_t pastEmptyFrom(const KernelParams& p, std::int64_t k, int mcShift) const {
+    return pastEmpty(p, field_, cube_, o_, d_, k, mcShift);
+  }
+
+  std::int64_t k_ = 0, end_ = -1;  // the next sample to look at; the last in the visible box
+  ChordEnds ends_;
+  Accumulator acc_;
+
+ private:
+  CubeExit cube_;
+  const std::uint8_t* field_ = nullptr;  // the distance field this ray leaps by (pastEmpty)
+  float o_[3], d_[3];                    // the ray's origin and step in float, as the samples'
+};
+
 // One ray's walk through the brick, a look-up at a time: castRay takes
 // one ray's steps in turn; castRays takes the steps of several rays by
 // turns, so that their chains of dependent arithmetic and loads a look-up
 // is (position, macrocell, distance, leap) overlap in the CPU.
 template <typename T, bool kShaded, bool kPreintegrated, int kPower = kTablePower>
-class RayWalk {
+class RayWalk : public LeapingWalk<RayWalk<T, kShaded, kPreintegrated, kPower>> {
+  using Base = LeapingWalk<RayWalk>;
+  using Base::k_, Base::end_, Base::ends_, Base::acc_;
+
  public:
+  using Base::finish;
+
   // Sets the walk up; false when the ray is done already (out holds its
   // result: no sample here, a short chord, or no visible macrocell). The
   // ray's samples outside `span` are known to lie in invisible macrocells
@@ -265,27 +328,12 @@ class RayWalk {
   // Sets the walk up from where it starts (start(), or startInLanes in
   // start_lanes.h, which finds the same for eight rays at once).
   void begin(const KernelParams& p, const RaySetup& ray, int mcShift, const WalkStart& at) {
+    this->beginAt(p, ray, mcShift, at);
     first_ = at.first;
     last_ = at.last;
-    k_ = at.k;
-    end_ = at.end;
-    ends_ = at.ends;
-    floatRay(ray, o_, d_);
     done_ = first_;
     leapFrom_ = std::numeric_limits<std::int64_t>::min();
     chunk_ = visibleChunk(ray);
-    cube_ = CubeExit(ray, mcShift);
-    field_ = p.leapField[octantOf(ray)];
-  }
-
-  // One look-up, and a chunk of samples where it finds something visible.
-  // False when the ray is done (out holds its result).
-  bool step(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
-    if (const std::int64_t next = pastEmpty(p, field_, cube_, o_, d_, k_, mcShift); next != k_) {
-      k_ = next;
-      return k_ <= end_ || finish(out);
-    }
-    return chunkAt(k_, p, ray, mcShift, out);
   }
 
   // step() after a look-up that found sample k's macrocell visible (k at
@@ -314,8 +362,7 @@ class RayWalk {
       std::int64_t& exit;
       std::int64_t next(std::int64_t at) const {
         if (at > walk.end_) return at;
-        if (const std::int64_t past = pastEmpty(p, walk.field_, walk.cube_, walk.o_, walk.d_, at, mcShift);
-            past != at) {
+        if (const std::int64_t past = walk.pastEmptyFrom(p, at, mcShift); past != at) {
           walk.leapFrom_ = at;
           walk.leapTo_ = past;
           return at;
@@ -336,34 +383,16 @@ class RayWalk {
     return k_ <= end_ || finish(out);
   }
 
-  bool finish(RayResult& out) const {
-    out.colour = acc_.rgba();
-    return false;
-  }
-
-  // The sample the walk looks at next.
-  std::int64_t at() const { return k_; }
   // Where the walk started (begin), before it took a step.
   WalkStart started() const { return {first_, last_, k_, end_, ends_}; }
-  // Lane i of `lanes` takes this walk's look-ups (walkInLanes).
-  template <typename Lanes>
-  void toLane(Lanes& lanes, int i) const {
-    lanes.set(i, o_, d_, cube_, field_, k_, end_);
-  }
 
  private:
   std::int64_t first_ = 0, last_ = -1;  // the ray's samples in the brick
-  std::int64_t k_ = 0, end_ = -1;       // the next sample to look at; the last in the visible box
   std::int64_t done_ = 0;               // next sample not yet composited or skipped
   std::int64_t chunk_ = 0;
   // The last look-up the batch loop made that found no chunk: at leapFrom_,
   // leap to leapTo_ (walks go forward, so an older one is never met again).
   std::int64_t leapFrom_ = std::numeric_limits<std::int64_t>::min(), leapTo_ = 0;
-  ChordEnds ends_;
-  CubeExit cube_;
-  const std::uint8_t* field_ = nullptr;  // the distance field this ray leaps by (pastEmpty)
-  float o_[3], d_[3];  // the ray's origin and step in float, as the samples'
-  Accumulator acc_;
 };
 
 // One ray by a Walk (RayWalk, or cast_ray_levels.h's LevelWalk): its

@@ -94,7 +94,7 @@ inline constexpr std::int64_t kBlocksPerChunk = 16;
 // changes by an ulp). bench/results/plain.txt, section 8.
 inline constexpr std::int64_t kCoarseChunk = 4 * kVisibleChunk;
 
-// One ray's march by levels, a step at a time, with RayWalk's interface,
+// One ray's march by levels, a step at a time, a LeapingWalk as RayWalk is,
 // so that the vector lanes start rays and take their look-ups past empty
 // space for it (startInLanes, walkInLanes), sixteen rays at once, as
 // castRays does: one ray at a time, the march's own scalar look-ups were a
@@ -102,8 +102,13 @@ inline constexpr std::int64_t kCoarseChunk = 4 * kVisibleChunk;
 // Each ray takes the look-ups, leaps and chunks of the loop one ray at a
 // time took, in the same order: the same samples and bits.
 template <typename T, bool kShaded>
-class LevelWalk {
+class LevelWalk : public LeapingWalk<LevelWalk<T, kShaded>> {
+  using Base = LeapingWalk<LevelWalk>;
+  using Base::k_, Base::end_, Base::ends_, Base::acc_;
+
  public:
+  using Base::finish;
+
   // Sets the march up; false when the ray is done already (out holds its
   // result). The ray's samples outside `span` lie in invisible macrocells
   // (tileSpan(), tile_start.h).
@@ -126,29 +131,14 @@ class LevelWalk {
   // Sets the march up from where it starts (start(), or startInLanes,
   // which finds the same as RayWalk::start for eight rays at once).
   void begin(const KernelParams& p, const RaySetup& ray, int mcShift, const WalkStart& at) {
-    k_ = at.k;
-    end_ = at.end;
-    ends_ = at.ends;
-    floatRay(ray, o_, d_);
-    cube_ = CubeExit(ray, mcShift);
-    field_ = p.leapField[octantOf(ray)];
+    this->beginAt(p, ray, mcShift, at);
     fineChunk_ = visibleChunk(ray);
   }
 
-  // One look-up past empty space, or one chunk; false when the ray is done
-  // (out holds its result).
-  bool step(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
-    // Empty space is skipped as castRay skips it: a coarse sample in
-    // skipped space is transparent too.
-    if (const std::int64_t next = pastEmpty(p, field_, cube_, o_, d_, k_, mcShift); next != k_) {
-      k_ = next;
-      return k_ <= end_ || finish(out);
-    }
-    return chunkAt(k_, p, ray, mcShift, out);
-  }
-
-  // step() after a look-up that found fine sample k's macrocell visible:
-  // a chunk at the level of k's block.
+  // step() (LeapingWalk: empty space is skipped as castRay skips it, a
+  // coarse sample in skipped space being transparent too) after a look-up
+  // that found fine sample k's macrocell visible: a chunk at the level of
+  // k's block.
   bool chunkAt(std::int64_t k, const KernelParams& p, const RaySetup& ray, int /*mcShift*/, RayResult& out) {
     k_ = k;
     const std::int64_t block = k_ >> kLevelBlockShift, blockEnd = (block + 1) << kLevelBlockShift;
@@ -182,29 +172,11 @@ class LevelWalk {
     return k_ <= end_ || finish(out);
   }
 
-  bool finish(RayResult& out) const {
-    out.colour = acc_.rgba();
-    return false;
-  }
-
-  // The fine sample the march looks at next.
-  std::int64_t at() const { return k_; }
-  // Lane i of `lanes` takes this march's look-ups (walkInLanes).
-  template <typename Lanes>
-  void toLane(Lanes& lanes, int i) const {
-    lanes.set(i, o_, d_, cube_, field_, k_, end_);
-  }
-
  private:
-  std::int64_t k_ = 0, end_ = -1;  // the next fine sample not yet covered or skipped; the last in the visible box
-  std::int64_t fineChunk_ = 0;     // samples of a level-0 chunk
-  ChordEnds ends_;
-  CubeExit cube_;
-  const std::uint8_t* field_ = nullptr;  // the distance field this ray leaps by (pastEmpty)
-  float o_[3], d_[3];                    // the ray's origin and step in float, as the samples'
-  RaySetup coarse_[kStepLevels];         // the ray at level l, once a chunk of that level needs it
-  unsigned coarseSet_ = 0;               // bit l: coarse_[l] is set
-  Accumulator acc_;
+  // k_ (LeapingWalk) is the next fine sample not yet covered or skipped.
+  std::int64_t fineChunk_ = 0;    // samples of a level-0 chunk
+  RaySetup coarse_[kStepLevels];  // the ray at level l, once a chunk of that level needs it
+  unsigned coarseSet_ = 0;        // bit l: coarse_[l] is set
 };
 
 }  // namespace kernel

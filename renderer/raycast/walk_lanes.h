@@ -54,7 +54,7 @@ class WalkLanes {
 
   // Lane i walks the ray whose origin and step in float are o and d,
   // leaping by `cube` through `field`, from sample k to sample `end` (a
-  // RayWalk's, RayWalk::toLane).
+  // walk's, LeapingWalk::toLane).
   void set(int i, const float* o, const float* d, const CubeExit& cube, const std::uint8_t* field,
            std::int64_t k, std::int64_t end) {
     for (int a = 0; a < 3; ++a) {
@@ -127,7 +127,7 @@ class WalkLanes {
 // castRays' walks (RayWalk) walk[0, n), going[i] when walk i has started
 // and is not done, to their ends: each round one vector look-up for each
 // eight of them; the walks whose look-up lands past their end are done,
-// those that find their macrocell visible take a chunk (RayWalk::chunkAt),
+// those that find their macrocell visible take a chunk (Walk::chunkAt),
 // the others leap on in their lanes. Each walk takes the look-ups, leaps
 // and chunks RayWalk::step would, in the same order, so its result is
 // castRay's.
