@@ -20,6 +20,10 @@
 // castRays' are (LevelWalk, castRaysByLevels).
 #pragma once
 
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+#include <immintrin.h>
+#endif
+
 #include "cast_ray.h"
 #include "step_levels.h"
 
@@ -52,23 +56,64 @@ inline std::int64_t fineOf(std::int64_t j, int level) {
 
 // The level of the macrocell at fine coordinate k, clamped into the domain
 // (the same macrocell for every brick) and, for safety, into the layout.
+// The position is rounded once (walkMulAdd), as levelsOfBlocks' lanes
+// round it.
 inline int levelAt(const KernelParams& p, const RaySetup& ray, double k) {
   std::size_t index = 0;
   for (int a = 2; a >= 0; --a) {
-    const double u = ray.origin[a] + k * ray.step[a];
+    const double u = walkMulAdd(k, ray.step[a], ray.origin[a]);
     const int m = std::clamp(int(std::floor(u)) >> MacrocellLayout::kShift, 0, p.lvDomainLast[a]);
     index = index * std::size_t(p.lvCount[a]) + std::size_t(std::clamp(m - p.lvFirst[a], 0, p.lvCount[a] - 1));
   }
   return p.levels[index];
 }
 
-// Block b's level: at its middle (the field is eroded by a block's reach,
-// StepLevels::choose); fine (0) at the chord's ends.
-inline int blockLevel(const KernelParams& p, const RaySetup& ray, const ChordEnds& ends, std::int64_t b) {
+// Where a block's level is read: its middle (the field is eroded by a
+// block's reach, StepLevels::choose).
+inline double blockMiddle(std::int64_t b) { return double((b << kLevelBlockShift) + kLevelBlock / 2); }
+
+// True when block b holds an end of the chord: it stays fine (level 0).
+inline bool holdsChordEnd(const ChordEnds& ends, std::int64_t b) {
   const std::int64_t lo = b << kLevelBlockShift, hi = lo + kLevelBlock - 1;
-  if ((ends.first >= lo && ends.first <= hi) || (ends.last >= lo && ends.last <= hi)) return 0;
-  return levelAt(p, ray, double(lo + kLevelBlock / 2));
+  return (ends.first >= lo && ends.first <= hi) || (ends.last >= lo && ends.last <= hi);
 }
+
+// levelAt() at the middles of blocks b .. b + kBlocksAtOnce - 1, into
+// out: eight in the lanes of a vector where the CPU has AVX-512. A march
+// scans the blocks ahead for the chunk's level block by block, and one at
+// a time each look-up (a double position per axis, its macrocell clamped
+// twice, an index and a load) was most of the march's own cost at coarse
+// levels.
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+inline constexpr int kBlocksAtOnce = 8;
+
+inline void levelsOfBlocks(const KernelParams& p, const RaySetup& ray, std::int64_t b, std::uint8_t* out) {
+  const __mmask8 all = 0xff;  // preint::kAll's reason: GCC 12 and the unmasked forms
+  constexpr double kStride = double(kLevelBlock);
+  const __m512d k = _mm512_add_pd(_mm512_set1_pd(blockMiddle(b)),
+                                  _mm512_setr_pd(0, kStride, 2 * kStride, 3 * kStride, 4 * kStride, 5 * kStride,
+                                                 6 * kStride, 7 * kStride));
+  __m256i index = _mm256_setzero_si256();
+  for (int a = 2; a >= 0; --a) {
+    const __m512d u = _mm512_fmadd_pd(k, _mm512_set1_pd(ray.step[a]), _mm512_set1_pd(ray.origin[a]));
+    const __m512d down = _mm512_maskz_roundscale_pd(all, u, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+    __m256i m = _mm256_srai_epi32(_mm512_maskz_cvttpd_epi32(all, down), MacrocellLayout::kShift);
+    m = _mm256_min_epi32(_mm256_max_epi32(m, _mm256_setzero_si256()), _mm256_set1_epi32(p.lvDomainLast[a]));
+    m = _mm256_sub_epi32(m, _mm256_set1_epi32(p.lvFirst[a]));
+    m = _mm256_min_epi32(_mm256_max_epi32(m, _mm256_setzero_si256()), _mm256_set1_epi32(p.lvCount[a] - 1));
+    index = _mm256_add_epi32(_mm256_mullo_epi32(index, _mm256_set1_epi32(p.lvCount[a])), m);
+  }
+  alignas(32) std::int32_t at[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(at), index);
+  for (int j = 0; j < 8; ++j) out[j] = p.levels[at[j]];
+}
+#else
+inline constexpr int kBlocksAtOnce = 1;
+
+inline void levelsOfBlocks(const KernelParams& p, const RaySetup& ray, std::int64_t b, std::uint8_t* out) {
+  out[0] = std::uint8_t(levelAt(p, ray, blockMiddle(b)));
+}
+#endif
 
 // Blocks a chunk may join when they take the same level: a chunk is
 // marched without looking at empty space again. A block holds 2^(6-l)
@@ -133,6 +178,7 @@ class LevelWalk : public LeapingWalk<LevelWalk<T, kShaded>> {
   void begin(const KernelParams& p, const RaySetup& ray, int mcShift, const WalkStart& at) {
     this->beginAt(p, ray, mcShift, at);
     fineChunk_ = visibleChunk(ray);
+    levelsFrom_ = (at.k >> kLevelBlockShift) - kBlocksAtOnce;  // none known
   }
 
   // step() (LeapingWalk: empty space is skipped as castRay skips it, a
@@ -142,10 +188,10 @@ class LevelWalk : public LeapingWalk<LevelWalk<T, kShaded>> {
   bool chunkAt(std::int64_t k, const KernelParams& p, const RaySetup& ray, int /*mcShift*/, RayResult& out) {
     k_ = k;
     const std::int64_t block = k_ >> kLevelBlockShift, blockEnd = (block + 1) << kLevelBlockShift;
-    const int level = blockLevel(p, ray, ends_, block);
+    const int level = blockLevel(p, ray, block);
     if (level == 0) {
       std::int64_t exit = std::min(end_ + 1, k_ + fineChunk_);
-      if (exit > blockEnd && blockLevel(p, ray, ends_, block + 1) != 0) exit = blockEnd;
+      if (exit > blockEnd && blockLevel(p, ray, block + 1) != 0) exit = blockEnd;
       if (runSpan<T, kShaded, false>(p, ray, ends_, k_, exit, acc_, out.samples)) return finish(out);
       k_ = exit;
       return k_ <= end_ || finish(out);
@@ -160,10 +206,10 @@ class LevelWalk : public LeapingWalk<LevelWalk<T, kShaded>> {
     const std::int64_t start = coarseFrom(k_, level);
     std::int64_t runEnd = blockEnd;
     while (runEnd <= end_ && runEnd - blockEnd < (kBlocksPerChunk - 1) * kLevelBlock &&
-           (runEnd >> level) - start < kCoarseChunk && blockLevel(p, ray, ends_, runEnd >> kLevelBlockShift) == level)
+           (runEnd >> level) - start < kCoarseChunk && blockLevel(p, ray, runEnd >> kLevelBlockShift) == level)
       runEnd += kLevelBlock;
     const std::int64_t exit = std::min({coarseFrom(end_ + 1, level), runEnd >> level, start + kCoarseChunk});
-    // A coarse chunk has no chord end in it (blockLevel).
+    // A coarse chunk has no chord end in it (blockLevel()).
     const ChordEnds noEnds{-1, std::numeric_limits<std::int64_t>::max(), 0, 0};
     if (start < exit && runSpan<T, kShaded, false>(p.atLevel[level], coarse_[level], noEnds, start, exit, acc_,
                                                    out.samples))
@@ -173,8 +219,23 @@ class LevelWalk : public LeapingWalk<LevelWalk<T, kShaded>> {
   }
 
  private:
+  // Block b's level: levelAt() at its middle, fine (0) where it holds an
+  // end of the chord. The march asks for blocks in increasing order, so the
+  // levels of the blocks from b on are read kBlocksAtOnce at a time and
+  // kept.
+  int blockLevel(const KernelParams& p, const RaySetup& ray, std::int64_t b) {
+    if (holdsChordEnd(ends_, b)) return 0;
+    if (b < levelsFrom_ || b >= levelsFrom_ + kBlocksAtOnce) {
+      levelsOfBlocks(p, ray, b, levels_);
+      levelsFrom_ = b;
+    }
+    return levels_[b - levelsFrom_];
+  }
+
   // k_ (LeapingWalk) is the next fine sample not yet covered or skipped.
   std::int64_t fineChunk_ = 0;    // samples of a level-0 chunk
+  std::int64_t levelsFrom_ = 0;   // levels_[i] is block levelsFrom_ + i's levelAt()
+  std::uint8_t levels_[kBlocksAtOnce];
   RaySetup coarse_[kStepLevels];  // the ray at level l, once a chunk of that level needs it
   unsigned coarseSet_ = 0;        // bit l: coarse_[l] is set
 };
