@@ -290,6 +290,7 @@ class LeapingWalk {
 template <typename T, bool kShaded, bool kPreintegrated, int kPower = kTablePower>
 class RayWalk : public LeapingWalk<RayWalk<T, kShaded, kPreintegrated, kPower>> {
   using Base = LeapingWalk<RayWalk>;
+  // The base's names, for use unqualified here (a template's base is not searched).
   using Base::k_, Base::end_, Base::ends_, Base::acc_;
 
  public:

@@ -88,7 +88,6 @@ inline bool holdsChordEnd(const ChordEnds& ends, std::int64_t b) {
 inline constexpr int kBlocksAtOnce = 8;
 
 inline void levelsOfBlocks(const KernelParams& p, const RaySetup& ray, std::int64_t b, int* out) {
-  const __mmask8 all = 0xff;  // preint::kAll's reason: GCC 12 and the unmasked forms
   constexpr double kStride = double(kLevelBlock);
   const __m512d k = _mm512_add_pd(_mm512_set1_pd(blockMiddle(b)),
                                   _mm512_setr_pd(0, kStride, 2 * kStride, 3 * kStride, 4 * kStride, 5 * kStride,
@@ -96,8 +95,8 @@ inline void levelsOfBlocks(const KernelParams& p, const RaySetup& ray, std::int6
   __m256i index = _mm256_setzero_si256();
   for (int a = 2; a >= 0; --a) {
     const __m512d u = _mm512_fmadd_pd(k, _mm512_set1_pd(ray.step[a]), _mm512_set1_pd(ray.origin[a]));
-    const __m512d down = _mm512_maskz_roundscale_pd(all, u, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
-    __m256i m = _mm256_srai_epi32(_mm512_maskz_cvttpd_epi32(all, down), MacrocellLayout::kShift);
+    const __m512d down = _mm512_maskz_roundscale_pd(preint::kAll, u, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+    __m256i m = _mm256_srai_epi32(_mm512_maskz_cvttpd_epi32(preint::kAll, down), MacrocellLayout::kShift);
     m = _mm256_min_epi32(_mm256_max_epi32(m, _mm256_setzero_si256()), _mm256_set1_epi32(p.lvDomainLast[a]));
     m = _mm256_sub_epi32(m, _mm256_set1_epi32(p.lvFirst[a]));
     m = _mm256_min_epi32(_mm256_max_epi32(m, _mm256_setzero_si256()), _mm256_set1_epi32(p.lvCount[a] - 1));
@@ -149,6 +148,7 @@ inline constexpr std::int64_t kCoarseChunk = 4 * kVisibleChunk;
 template <typename T, bool kShaded>
 class LevelWalk : public LeapingWalk<LevelWalk<T, kShaded>> {
   using Base = LeapingWalk<LevelWalk>;
+  // The base's names, for use unqualified here (a template's base is not searched).
   using Base::k_, Base::end_, Base::ends_, Base::acc_;
 
  public:
