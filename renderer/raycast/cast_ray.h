@@ -239,7 +239,7 @@ class LeapingWalk {
   // One look-up, and a chunk of samples where it finds something visible.
   // False when the ray is done (out holds its result).
   bool step(const KernelParams& p, const RaySetup& ray, int mcShift, RayResult& out) {
-    if (const std::int64_t next = pastEmpty(p, field_, cube_, o_, d_, k_, mcShift); next != k_) {
+    if (const std::int64_t next = pastEmptyFrom(p, k_, mcShift); next != k_) {
       k_ = next;
       return k_ <= end_ || finish(out);
     }
