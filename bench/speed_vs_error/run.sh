@@ -4,7 +4,8 @@
 # Installs what is missing, builds speed_vs_error and pvr-render (Release,
 # assertions off) in build-bench/, writes the peer benchmark's volume to
 # build/bench-data/, times the peer scene beside VTK's fixed-point ray caster
-# on the peer's own camera path with both errors against one reference
+# on the peer's own camera path (the two by turns, three rounds) with both
+# errors against one reference
 # (VTK's frame at the scene's own view, bench/speed_vs_error/vtk_own_view.py),
 # runs the sweep (table on stdout,
 # bench/results/speed_vs_error.csv), plots PSNR against time per frame
@@ -14,7 +15,8 @@
 # Knobs: BENCH_BUILD (build dir, default build-bench), BENCH_ARGS (extra
 # speed_vs_error options for the sweep, e.g. "--frames 3" or scene files),
 # BENCH_CASE_SECONDS (3: stop timing a case after this long, at least one
-# frame), BENCH_SKIP_INSTALL=1, BENCH_SKIP_VTK=1, BENCH_SOURCE (names the
+# frame), BENCH_VTK_ROUNDS (3: rounds of VTK's run and ours by turns),
+# BENCH_SKIP_INSTALL=1, BENCH_SKIP_VTK=1, BENCH_SOURCE (names the
 # source tree in the results when it is not a git checkout).
 set -euo pipefail
 
