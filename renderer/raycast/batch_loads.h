@@ -118,6 +118,14 @@ template <typename T>
 }
 #endif
 
+// The 32-bit words at b + index[j] of eight lanes, as loadPairs8 fetches
+// integer voxels (kBroadcastPairs).
+template <typename T>
+[[gnu::always_inline]] inline __m256i loadWords8(const T* b, const std::int32_t* index) {
+  if constexpr (kBroadcastPairs) return broadcastWords8(b, index);
+  return gatherWords8(b, index);
+}
+
 // Voxels index[j] + offset and index[j] + offset + 1 of eight lanes.
 //
 // Integer voxels: one 32-bit word per lane, which holds both neighbours
@@ -132,10 +140,8 @@ template <typename T>
                                               __m256& lo, __m256& hi) {
   if constexpr (std::is_floating_point_v<T>) {
     load64x8(v + offset, index, lo, hi);
-  } else if constexpr (kBroadcastPairs) {
-    splitPairs8<T>(broadcastWords8(v + offset, index), lo, hi);
   } else {
-    splitPairs8<T>(gatherWords8(v + offset, index), lo, hi);
+    splitPairs8<T>(loadWords8(v + offset, index), lo, hi);
   }
 }
 

@@ -59,6 +59,9 @@ struct KernelParams {
   // transparent (both entries classify1D reads are zero): the batched
   // kernel skips a batch whose samples all lie there (setTables).
   float clearBelow = 0, clearAbove = FLT_MAX;
+  // One bit per voxel index: set where that cell's samples all classify
+  // as transparent (ClearCells, clear_cells.h), null when none are known.
+  const std::uint8_t* clearCells = nullptr;
   PreintegralTables preint;  // pre-integration's integral tables
   double stepLength = 0;     // world length of one step, h
   float earlyTermination = 1;

@@ -121,8 +121,13 @@ void setLevels(KernelParams& p, const StepLevels& levels, const std::vector<Tran
     p.lvDomainLast[a] = int(levels.domainCount()[a] - 1);
   }
   atLevel.assign(tables.size(), p);
-  for (std::size_t l = 0; l < tables.size(); ++l)
-    setTables(atLevel[l], tables[l], nullptr, fineStep * double(std::int64_t(1) << l));
+  for (std::size_t l = 0; l < tables.size(); ++l) {
+    KernelParams& level = atLevel[l];
+    setTables(level, tables[l], nullptr, fineStep * double(std::int64_t(1) << l));
+    // The clear cells are p's table's: a level's table with other
+    // transparent ends does not read them.
+    if (level.clearBelow != p.clearBelow || level.clearAbove != p.clearAbove) level.clearCells = nullptr;
+  }
   p.atLevel = atLevel.data();
 }
 

@@ -41,7 +41,8 @@ void setTables(KernelParams& p, const TransferTable& table, const PreintegratedT
 
 // Quality chosen by error: `levels`' field in p (filled but for it), and
 // in `atLevel` a copy of p per level with that level's table and step
-// (tables[l], 2^l fineStep); p.atLevel points to it. The tables and
+// (tables[l], 2^l fineStep), and p's clear cells where the level's table
+// has the same transparent ends; p.atLevel points to it. The tables and
 // atLevel must outlive p.
 void setLevels(KernelParams& p, const StepLevels& levels, const std::vector<TransferTable>& tables,
                double fineStep, std::vector<KernelParams>& atLevel);

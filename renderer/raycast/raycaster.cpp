@@ -99,6 +99,10 @@ void BrickRenderer::classify(const TransferFunctionSpec& tf, const RenderOptions
   preintegrated_.reset();
   if (options.preintegrated) preintegrated_ = std::make_unique<PreintegratedTable>(tf);
   macrocells_.classify(table_, options.skipEmpty, pool);
+  KernelParams byTable;
+  setBrick(byTable, brick_, macrocells_);
+  setTables(byTable, table_, nullptr, options.step);
+  clearCells_.build(byTable, brick_, pool);
   classifiedStep_ = options.step;
 }
 
@@ -144,6 +148,7 @@ Image BrickRenderer::render(const Camera& camera, const RenderOptions& options, 
                       : preintegrated_ ? preint::sampleSpacing(options.step, grid.minSpacing())
                                        : options.step;
   setTables(p, table_, preintegrated_.get(), step);
+  p.clearCells = clearCells_.bits();
   const std::vector<float> specular = specularTable(options.shading.shininess);
   setOptions(p, options, specular.data());
   std::vector<KernelParams> atLevel;

@@ -22,6 +22,7 @@
 #include "../scene.h"
 #include "../thread_pool.h"
 #include "../transfer.h"
+#include "clear_cells.h"
 #include "macrocells.h"
 #include "step_levels.h"
 
@@ -104,6 +105,7 @@ class BrickRenderer {
   // stays) and one table per level; empty tables when it is off.
   std::unique_ptr<StepLevels> levels_;
   std::vector<TransferTable> levelTables_;
+  ClearCells clearCells_;  // of table_ (plain batches)
   double classifiedStep_ = 0;
   std::optional<WorldRegion> region_;
 };

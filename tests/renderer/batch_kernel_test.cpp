@@ -23,12 +23,6 @@
 namespace pvr::core {
 namespace {
 
-TransferFunctionSpec transfer(std::vector<TransferPoint> points) {
-  TransferFunctionSpec tf;
-  tf.points = std::move(points);
-  tf.unitDistance = 1.0;
-  return tf;
-}
 
 using Setup = KernelFixture;
 using test::alongX;

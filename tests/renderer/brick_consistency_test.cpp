@@ -35,10 +35,6 @@
 namespace pvr::core {
 namespace {
 
-ThreadPool& pool() {
-  static ThreadPool p(2);
-  return p;
-}
 
 // A k-d tree of node planes; leaves are bricks.
 struct Split {

@@ -29,17 +29,7 @@
 namespace pvr::core {
 namespace {
 
-ThreadPool& pool() {
-  static ThreadPool p(2);
-  return p;
-}
 
-TransferFunctionSpec transfer(std::vector<TransferPoint> points) {
-  TransferFunctionSpec tf;
-  tf.points = std::move(points);
-  tf.unitDistance = 1.0;
-  return tf;
-}
 
 // uint8 values: 0 around, a soft blob of up to 120 in the middle of the
 // 40^3 grid and a speck of 250 at the eight nodes of cell (37, 1, 37), in

@@ -94,11 +94,6 @@ inline std::vector<TestVolume> disjointVolumes() {
   return volumes;
 }
 
-// Two worker threads for every test's renders.
-inline ThreadPool& pool() {
-  static ThreadPool p(2);
-  return p;
-}
 
 // The whole scene in one SceneRenderer, as a full frame.
 inline Image castScene(const std::vector<TestVolume>& volumes, const Camera& camera, const RenderOptions& o,

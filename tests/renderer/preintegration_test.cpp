@@ -19,12 +19,6 @@
 namespace pvr::core {
 namespace {
 
-TransferFunctionSpec transfer(std::vector<TransferPoint> points, double unitDistance = 1.0) {
-  TransferFunctionSpec tf;
-  tf.points = std::move(points);
-  tf.unitDistance = unitDistance;
-  return tf;
-}
 
 // The segment's integral: the scalar runs linearly from `front` to `back`
 // over `length`; midpoint rule on n substeps, each attenuating exactly.

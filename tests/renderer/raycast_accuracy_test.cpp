@@ -24,10 +24,6 @@
 namespace pvr::core {
 namespace {
 
-ThreadPool& pool() {
-  static ThreadPool p(2);
-  return p;
-}
 
 Camera orthographic(Vec3 eye, Vec3 at, Vec3 up, double height, int width, int heightPx) {
   return makeCamera(Projection::kOrthographic, eye, at, up, height, width, heightPx);
@@ -37,12 +33,6 @@ Camera perspective(Vec3 eye, Vec3 at, Vec3 up, double fovYDeg, int width, int he
   return makeCamera(Projection::kPerspective, eye, at, up, fovYDeg, width, heightPx);
 }
 
-TransferFunctionSpec transfer(std::vector<TransferPoint> points, double unitDistance) {
-  TransferFunctionSpec tf;
-  tf.points = std::move(points);
-  tf.unitDistance = unitDistance;
-  return tf;
-}
 
 // The same colour and opacity for every scalar in [lo, hi] (and, clamped, beyond).
 TransferFunctionSpec constantTransfer(double r, double g, double b, double opacity, double lo,

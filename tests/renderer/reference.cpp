@@ -244,6 +244,18 @@ double marschnerLobb(Vec3 p) {
   return (1 - std::sin(pi * p.z / 2) + kAlpha * (1 + rhoR)) / (2 * (1 + kAlpha));
 }
 
+TransferFunctionSpec transfer(std::vector<TransferPoint> points, double unitDistance) {
+  TransferFunctionSpec tf;
+  tf.points = std::move(points);
+  tf.unitDistance = unitDistance;
+  return tf;
+}
+
+ThreadPool& pool() {
+  static ThreadPool p(2);
+  return p;
+}
+
 GridGeometry cubeGrid(std::int64_t n) {
   GridGeometry g;
   g.dims = {n, n, n};

@@ -133,6 +133,12 @@ GridGeometry cubeGrid(std::int64_t n);
 Camera makeCamera(Projection projection, Vec3 eye, Vec3 lookAt, Vec3 up, double extent,
                   int width, int height);
 
+// A transfer function of `points` with its opacity per `unitDistance`.
+TransferFunctionSpec transfer(std::vector<TransferPoint> points, double unitDistance = 1.0);
+
+// Two worker threads for a test binary's renders.
+ThreadPool& pool();
+
 // Render options with everything else at its default (no early termination,
 // skipping on, default shading parameters).
 RenderOptions makeOptions(double step, bool preintegrated = false, bool shaded = false);

@@ -22,10 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-ThreadPool& pool() {
-  static ThreadPool p(2);
-  return p;
-}
 
 // Renders an example scene at `side` x `side` pixels with the target, and
 // its reference (dt = a 32nd of a voxel); returns the PSNR and the samples

@@ -1,0 +1,122 @@
+// Clear cells (renderer/raycast/clear_cells.h): the cells whose samples all
+// classify as transparent, which the batched kernel skips before reading a
+// voxel. Which cells are marked, and that the skip leaves every image bit
+// for bit as it was: an integer brick (with clear cells) renders exactly as
+// its float copy (float bricks have none) does.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "raycast/clear_cells.h"
+#include "raycast/kernel.h"
+#include "raycast/kernel_setup.h"
+#include "raycast/macrocells.h"
+#include "raycast/raycaster.h"
+#include "reference.h"
+#include "transfer.h"
+
+namespace pvr::core {
+namespace {
+
+
+
+// Integer node values on 40^3 nodes: 0 around, a soft blob of up to 120 in
+// the middle and a speck of 250 at the eight nodes of cell (30, 8, 30).
+double speckAndBlob(Vec3 p) {
+  const Vec3 blob = p - Vec3{20, 19, 21}, speck = p - Vec3{30.5, 8.5, 30.5};
+  if (std::max({std::abs(speck.x), std::abs(speck.y), std::abs(speck.z)}) < 0.6) return 250.0;
+  return std::round(120.0 * std::exp(-dot(blob, blob) / (2 * 5.0 * 5.0)));
+}
+
+// Opacity only from 200 up: the speck alone is visible.
+TransferFunctionSpec speckOnly() { return transfer({{0, 0, 0, 0, 0}, {200, 0, 0, 0, 0}, {250, 1, 0.5, 0.2, 0.9}}); }
+
+// Opacity between 40 and 130 only: the speck's value lies in the table's
+// transparent high end, the ground's in its low end.
+TransferFunctionSpec blobOnly() {
+  return transfer({{0, 0, 0, 0, 0}, {40, 0.2, 0.5, 0.9, 0}, {80, 0.4, 0.8, 0.6, 0.3}, {130, 0, 0, 0, 0},
+                   {255, 0, 0, 0, 0}});
+}
+
+// The bit of cell (i, j, k) of a whole-volume brick of n^3 nodes.
+bool clearCell(const ClearCells& cells, std::int64_t n, int i, int j, int k) {
+  const std::int64_t at = i + j * n + k * n * n;
+  return (cells.bits()[at >> 3] >> (at & 7)) & 1;
+}
+
+ClearCells clearCellsOf(const Brick& brick, const TransferFunctionSpec& tf) {
+  const MacrocellGrid macrocells(brick);
+  const TransferTable table(tf, 0.5);
+  KernelParams p;
+  setBrick(p, brick, macrocells);
+  setTables(p, table, nullptr, 0.5);
+  ClearCells cells;
+  cells.build(p, brick, &pool());
+  return cells;
+}
+
+TEST_CASE("a cell is clear when its eight nodes all lie in one transparent end of the table") {
+  const Brick brick = makeVolume(cubeGrid(40), ScalarType::kUInt8, speckAndBlob);
+  const ClearCells speck = clearCellsOf(brick, speckOnly());
+  REQUIRE(speck.bits() != nullptr);
+  CHECK(clearCell(speck, 40, 0, 0, 0));     // ground
+  CHECK(clearCell(speck, 40, 20, 19, 21));  // the blob's middle, 120: below the visible 200
+  // The speck's cell and every cell that shares one of its nodes.
+  for (int k = 29; k <= 31; ++k)
+    for (int j = 7; j <= 9; ++j)
+      for (int i = 29; i <= 31; ++i) CHECK_FALSE(clearCell(speck, 40, i, j, k));
+  CHECK(clearCell(speck, 40, 28, 8, 30));  // one cell further: all its nodes 0
+
+  const ClearCells blob = clearCellsOf(brick, blobOnly());
+  REQUIRE(blob.bits() != nullptr);
+  CHECK(clearCell(blob, 40, 0, 0, 0));         // ground, the low end
+  CHECK(clearCell(blob, 40, 30, 8, 30));       // the speck's own cell, the high end
+  CHECK_FALSE(clearCell(blob, 40, 29, 8, 30));  // 0 and 250: its samples pass the visible middle
+  CHECK_FALSE(clearCell(blob, 40, 20, 19, 21));  // the blob's middle is visible
+}
+
+TEST_CASE("no clear cells for a float brick or a table without a transparent end") {
+  const Brick floats = makeVolume(cubeGrid(24), ScalarType::kFloat32, speckAndBlob);
+  CHECK(clearCellsOf(floats, speckOnly()).bits() == nullptr);
+  const Brick bytes = makeVolume(cubeGrid(24), ScalarType::kUInt8, speckAndBlob);
+  CHECK(clearCellsOf(bytes, transfer({{0, 0.5, 0.5, 0.5, 0.1}, {255, 1, 1, 1, 0.5}})).bits() == nullptr);
+}
+
+TEST_CASE("skipping clear cells leaves the image bit for bit as it was") {
+  const GridGeometry grid = cubeGrid(40);
+  const std::vector<Camera> cameras = {
+      makeCamera(Projection::kPerspective, {80, -40, 75}, {20, 20, 20}, {0, 0, 1}, 45, 64, 64),
+      makeCamera(Projection::kOrthographic, {20, -60, 30}, {20, 20, 30}, {0, 0, 1}, 45, 64, 64),
+      makeCamera(Projection::kPerspective, {25, 12, 28}, {30, 8, 30}, {0, 0, 1}, 70, 64, 64)};
+  for (const ScalarType type : {ScalarType::kUInt8, ScalarType::kUInt16, ScalarType::kInt16}) {
+    const Brick integers = makeVolume(grid, type, speckAndBlob);
+    const Brick floats = makeVolume(grid, ScalarType::kFloat32, speckAndBlob);
+    for (const TransferFunctionSpec& tf : {speckOnly(), blobOnly()})
+      for (const bool shaded : {false, true})
+        for (const double step : {0.5, 1.0}) {
+          RenderOptions options = makeOptions(step, false, shaded);
+          BrickRenderer withCells(integers), without(floats);
+          withCells.classify(tf, options, &pool());
+          without.classify(tf, options, &pool());
+          for (const Camera& camera : cameras) {
+            RenderStats a, b;
+            const Image x = withCells.render(camera, options, pool(), &a).toFullFrame();
+            const Image y = without.render(camera, options, pool(), &b).toFullFrame();
+            CAPTURE(int(type), shaded, step);
+            CHECK(a.samples == b.samples);
+            int differing = 0;
+            for (std::size_t n = 0; n < x.pixels().size(); ++n) {
+              const Rgba& s = x.pixels()[n];
+              const Rgba& t = y.pixels()[n];
+              differing += s.r != t.r || s.g != t.g || s.b != t.b || s.a != t.a;
+            }
+            CHECK(differing == 0);
+          }
+        }
+  }
+}
+
+}  // namespace
+}  // namespace pvr::core
