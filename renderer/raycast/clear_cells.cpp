@@ -14,12 +14,15 @@ namespace {
 
 // 1: the node lies in the table's transparent low end, 2: in its high end,
 // each with a margin beyond what the reconstruction's rounding can move a
-// sample (a few ulp of the value, and of the table coordinate).
+// sample: its three levels of float lerps err by a few ulp of the cell's
+// largest magnitude (here, T's: a cell of -30000 and 5 errs near 5 by ulps
+// of 30000), the table coordinate's fused multiply-add by half an ulp.
 template <typename T>
 std::uint8_t nodeClass(T v, const KernelParams& p) {
+  constexpr double kLargest = std::max(-double(std::numeric_limits<T>::min()), double(std::numeric_limits<T>::max()));
   const double value = double(v);
   const double x = value * double(p.tableScale) + double(p.tableOffset);
-  const double margin = std::abs(double(p.tableScale)) * std::max(std::abs(value), 1.0) * 0x1p-18 + 0x1p-8;
+  const double margin = std::abs(double(p.tableScale)) * kLargest * 0x1p-18 + 0x1p-8;
   return std::uint8_t((x + margin < double(p.clearBelow) ? 1 : 0) | (x - margin >= double(p.clearAbove) ? 2 : 0));
 }
 
