@@ -94,7 +94,6 @@ inline std::vector<TestVolume> disjointVolumes() {
   return volumes;
 }
 
-
 // The whole scene in one SceneRenderer, as a full frame.
 inline Image castScene(const std::vector<TestVolume>& volumes, const Camera& camera, const RenderOptions& o,
                        RenderStats* stats = nullptr) {
