@@ -90,6 +90,11 @@ struct PreintegralTables {
   bool gaps = true;  // empty cells between the first visible cell and the last
 };
 
+// The one empty end whose cells pre-integrated batches skip by (ClearEnds::
+// ofSegments, clear_cells.h), the low one where the table has one: a
+// segment from one end to the other crosses the visible values between.
+inline bool segmentsClearBelow(const PreintegralTables& t) { return t.clearBelow > -INFINITY; }
+
 namespace preint {
 
 // Segments whose ends are closer than this (table coordinates) take the

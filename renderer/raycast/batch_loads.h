@@ -126,6 +126,17 @@ template <typename T>
   return gatherWords8(b, index);
 }
 
+// True when the bits at eight lanes' voxel indices (ClearCells) are all
+// set. The byte indices go through memory: read back as scalars, not
+// extracted on the shuffle port (classifyQuads).
+[[gnu::always_inline]] inline bool allCellsClear8(const std::uint8_t* bits, __m256i index) {
+  alignas(32) std::int32_t byte[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(byte), _mm256_srli_epi32(index, 3));
+  asm("" : "+m"(byte));
+  const __m256i bit = _mm256_srlv_epi32(loadWords8(bits, byte), _mm256_and_si256(index, _mm256_set1_epi32(7)));
+  return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_slli_epi32(bit, 31))) == 0xFF;
+}
+
 // Voxels index[j] + offset and index[j] + offset + 1 of eight lanes.
 //
 // Integer voxels: one 32-bit word per lane, which holds both neighbours

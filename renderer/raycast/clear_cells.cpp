@@ -18,12 +18,12 @@ namespace {
 // largest magnitude (here, T's: a cell of -30000 and 5 errs near 5 by ulps
 // of 30000), the table coordinate's fused multiply-add by half an ulp.
 template <typename T>
-std::uint8_t nodeClass(T v, const KernelParams& p) {
+std::uint8_t nodeClass(T v, const ClearEnds& ends) {
   constexpr double kLargest = std::max(-double(std::numeric_limits<T>::min()), double(std::numeric_limits<T>::max()));
   const double value = double(v);
-  const double x = value * double(p.tableScale) + double(p.tableOffset);
-  const double margin = std::abs(double(p.tableScale)) * kLargest * 0x1p-18 + 0x1p-8;
-  return std::uint8_t((x + margin < double(p.clearBelow) ? 1 : 0) | (x - margin >= double(p.clearAbove) ? 2 : 0));
+  const double x = value * double(ends.scale) + double(ends.offset);
+  const double margin = std::abs(double(ends.scale)) * kLargest * 0x1p-18 + 0x1p-8;
+  return std::uint8_t((x + margin < double(ends.below) ? 1 : 0) | (x - margin >= double(ends.above) ? 2 : 0));
 }
 
 inline void orInto(std::vector<std::uint64_t>& bits, std::int64_t word, std::uint64_t value) {
@@ -31,12 +31,12 @@ inline void orInto(std::vector<std::uint64_t>& bits, std::int64_t word, std::uin
 }
 
 template <typename T>
-void buildTyped(const KernelParams& p, std::vector<std::uint64_t>& bits, ThreadPool* pool) {
+void buildTyped(const ClearEnds& ends, const KernelParams& p, std::vector<std::uint64_t>& bits, ThreadPool* pool) {
   const T* v = static_cast<const T*>(p.voxels);
   // nodeClass of every value of T (8 or 16 bits), by its offset from the least.
   constexpr std::int64_t kLeast = std::numeric_limits<T>::min();
   std::vector<std::uint8_t> classOf(std::size_t(1) << (8 * sizeof(T)));
-  for (std::size_t n = 0; n < classOf.size(); ++n) classOf[n] = nodeClass(T(kLeast + std::int64_t(n)), p);
+  for (std::size_t n = 0; n < classOf.size(); ++n) classOf[n] = nodeClass(T(kLeast + std::int64_t(n)), ends);
   const std::uint8_t* cls = classOf.data();
   const int i0 = p.storedCellLo[0], j0 = p.storedCellLo[1], k0 = p.storedCellLo[2];
   const std::size_t width = std::size_t(p.storedCellHi[0] - i0 + 2);   // nodes of a row
@@ -103,18 +103,28 @@ void buildTyped(const KernelParams& p, std::vector<std::uint64_t>& bits, ThreadP
 
 }  // namespace
 
-void ClearCells::build(const KernelParams& p, const Brick& brick, ThreadPool* pool) {
+ClearEnds ClearEnds::ofSamples(const KernelParams& p) { return {p.tableScale, p.tableOffset, p.clearBelow, p.clearAbove}; }
+
+ClearEnds ClearEnds::ofSegments(const PreintegralTables& t) {
+  // Infinite ends (none, or every coordinate) as the finite bounds plain
+  // tables use.
+  if (segmentsClearBelow(t)) return {t.scale, t.offset, std::min(t.clearBelow, FLT_MAX), FLT_MAX};
+  return {t.scale, t.offset, -FLT_MAX, std::min(t.clearAbove, FLT_MAX)};
+}
+
+void ClearCells::build(const ClearEnds& ends, const KernelParams& p, const Brick& brick, ThreadPool* pool) {
   bits_.clear();
   const IVec3 extents = brick.stored().extents();
   const bool cells = extents.x > 1 && extents.y > 1 && extents.z > 1;
-  const bool transparentEnd = p.clearBelow > 0 || p.clearAbove < FLT_MAX;
+  // (A table's coordinates start at 0: a low end at or below 0 marks nothing.)
+  const bool transparentEnd = ends.below > 0 || ends.above < FLT_MAX;
   if (!cells || !transparentEnd || !p.indices32 || brick.type() == ScalarType::kFloat32) return;
   // A bit a node, and 4 bytes more: broadcastWords8 reads 4 from a lane's byte on.
   bits_.assign(std::size_t(brick.stored().nodeCount() / 64 + 2), 0);
   switch (brick.type()) {
-    case ScalarType::kUInt8: buildTyped<std::uint8_t>(p, bits_, pool); break;
-    case ScalarType::kUInt16: buildTyped<std::uint16_t>(p, bits_, pool); break;
-    case ScalarType::kInt16: buildTyped<std::int16_t>(p, bits_, pool); break;
+    case ScalarType::kUInt8: buildTyped<std::uint8_t>(ends, p, bits_, pool); break;
+    case ScalarType::kUInt16: buildTyped<std::uint16_t>(ends, p, bits_, pool); break;
+    case ScalarType::kInt16: buildTyped<std::int16_t>(ends, p, bits_, pool); break;
     case ScalarType::kFloat32: break;
   }
 }

@@ -13,27 +13,49 @@
 // The float lerps of the reconstruction may overshoot their ends by an ulp
 // or two, so a node counts as clear only with a margin beyond that.
 //
+// Pre-integrated segments (kernel_batch.h) skip by them too: a segment
+// integrates between its end nodes, which are clamped into the range of
+// their cells' nodes, so one between two nodes in clear cells of the same
+// end integrates nothing. Between the two ends it would cross the visible
+// values, so their cells mark one end only (ClearEnds::ofSegments).
+//
 // Integer voxels only (8 and 16 bits): their differences are exact in
 // float, and they have no NaN. The bit of a cell is that of the voxel index
 // (KernelParams) of its lowest node: 1/8 byte per stored voxel.
 #pragma once
 
+#include <cfloat>
 #include <cstdint>
 #include <vector>
 
 #include "../brick.h"
+#include "../preintegration.h"
 #include "../thread_pool.h"
 
 namespace pvr::core {
 
 struct KernelParams;
 
+// The transparent ends a bitmap marks, in table coordinates x = value *
+// scale + offset: x < below, or x >= above (FLT_MAX for no high end).
+struct ClearEnds {
+  float scale = 0, offset = 0;
+  float below = -FLT_MAX, above = FLT_MAX;
+
+  // Both ends of p's plain table (KernelParams::clearBelow, clearAbove):
+  // each sample is classified on its own.
+  static ClearEnds ofSamples(const KernelParams& p);
+  // One end of a pre-integrated table (PreintegralTables::clearBelow,
+  // clearAbove), the low one where it has one (segmentsClearBelow()).
+  static ClearEnds ofSegments(const PreintegralTables& t);
+};
+
 class ClearCells {
  public:
-  // The clear cells of `brick`'s stored box, classified by p's table
-  // (setBrick and setTables of this brick); none for a float brick, a box
-  // without cells or a table with no transparent end.
-  void build(const KernelParams& p, const Brick& brick, ThreadPool* pool);
+  // The cells of `brick`'s stored box (p: setBrick of this brick) whose
+  // nodes all lie in one of `ends`; none for a float brick, a box without
+  // cells or no transparent end.
+  void build(const ClearEnds& ends, const KernelParams& p, const Brick& brick, ThreadPool* pool);
 
   // The bits for KernelParams::clearCells; null when there are none.
   const std::uint8_t* bits() const {

@@ -83,7 +83,6 @@ inline bool runBatchedIndexed(const KernelParams& p, const RaySetup& ray, std::i
     bool clear;
   };
   const std::uint8_t* clearCells = p.clearCells;
-  const __m256i bitOfByte = _mm256_set1_epi32(7);
   auto reconstruct = [&](std::int64_t s) __attribute__((always_inline)) {
     Batch out;
     const __m256 k = _mm256_add_ps(_mm256_set1_ps(float(s)), lanes);
@@ -105,15 +104,8 @@ inline bool runBatchedIndexed(const KernelParams& p, const RaySetup& ray, std::i
     // peer scene's batches, 46 % of the CT head's; 2-5 % less CPU a frame,
     // as the bitmap's own eight loads a batch take back most of the reads
     // saved (bench/results/plain.txt, section 10).
-    out.clear = false;
-    if (clearCells) {
-      alignas(32) std::int32_t byte[8];
-      _mm256_store_si256(reinterpret_cast<__m256i*>(byte), _mm256_srli_epi32(voxelIndex, 3));
-      asm("" : "+m"(byte));  // read back as scalars, not extracted on the shuffle port (classifyQuads)
-      const __m256i bits = _mm256_srlv_epi32(loadWords8(clearCells, byte), _mm256_and_si256(voxelIndex, bitOfByte));
-      out.clear = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_slli_epi32(bits, 31))) == 0xFF;
-      if (out.clear) return out;
-    }
+    out.clear = clearCells && allCellsClear8(clearCells, voxelIndex);
+    if (out.clear) return out;
     // Trilinear reconstruction.
     __m256 a0, a1, b0, b1, c0, c1, e0, e1;
     loadPairs8(v, index, 0, a0, a1);
@@ -326,28 +318,27 @@ inline bool runPreintegratedIndexed(const KernelParams& p, const RaySetup& ray, 
   };
   using kOne = std::integral_constant<int, 12>;  // one sample before x's lanes
   using kTwo = std::integral_constant<int, 8>;   // two samples before
-  // The window at `start` (preintWindow()): the samples at start - 1 ..
-  // start + 6 in one batch; the front node at `start`, and the sample at
-  // start + 1 and its range for the first batch's first node.
-#ifndef PVR_HAVE_PREINT_LANES
-  preint::End frontEnd;
-#endif
-  float frontScalar;
-  {
+  // The window at sample `at` (preintWindow()), as a call from `at` opens
+  // it: the samples at at - 1 .. at + 6 in one batch; the sample at at + 1
+  // and its range carried for the first batch's first node. Returns the
+  // front node at `at`.
+  auto openWindow = [&](std::int64_t at) __attribute__((always_inline)) {
     alignas(32) float first[8], firstLo[8], firstHi[8];
     __m256 lo8, hi8;
-    _mm256_store_ps(first, aroundBatch<T, kShifted>(v, p, o, d, start - 1, lo8, hi8));
+    _mm256_store_ps(first, aroundBatch<T, kShifted>(v, p, o, d, at - 1, lo8, hi8));
     _mm256_store_ps(firstLo, lo8);
     _mm256_store_ps(firstHi, hi8);
-    frontScalar = curvedNode<T>(first[0], first[1], first[2], firstLo[1], firstHi[1]);
-    if (!finite<T>(frontScalar)) frontScalar = 0;  // looked up as 0 (segmentEnd())
-#ifndef PVR_HAVE_PREINT_LANES
-    frontEnd = preint::endAt(p.preint, frontScalar);
-#endif
+    float front = curvedNode<T>(first[0], first[1], first[2], firstLo[1], firstHi[1]);
+    if (!finite<T>(front)) front = 0;  // looked up as 0 (segmentEnd())
     carried = _mm256_set_ps(first[2], first[1], 0, 0, 0, 0, 0, 0);
     carriedLo = _mm256_set1_ps(firstLo[2]);
     carriedHi = _mm256_set1_ps(firstHi[2]);
-  }
+    return front;
+  };
+  const float frontScalar = openWindow(start);
+#ifndef PVR_HAVE_PREINT_LANES
+  preint::End frontEnd = preint::endAt(p.preint, frontScalar);
+#endif
   // On to the next batch, `count` segments done: the two samples before
   // its first node carried over.
   auto advance = [&](std::int64_t s, int count, __m256 x, __m256 xLo, __m256 xHi) __attribute__((always_inline)) {
@@ -368,6 +359,31 @@ inline bool runPreintegratedIndexed(const KernelParams& p, const RaySetup& ray, 
   float frontNode = frontScalar;
   bool frontStale = true;  // looked up by the first batch that needs it
   using Rows = std::true_type;
+  // A batch whose front node and eight nodes all lie in clear cells of
+  // the segments' end (p.clearCells, ClearEnds::ofSegments) integrates
+  // nothing, as allClear() would find; it is known from the batch before
+  // (its last node, the front, and the next eight samples' cells) and then
+  // skipped before its samples are read: the peer scene's unshaded frame
+  // took 10 % less CPU (bench/results/preintegration.txt). The window
+  // reopens at the next batch that is not skipped, as a call from there
+  // would open it (the same samples and nodes, so the same bits).
+  const std::uint8_t* clearCells = std::is_floating_point_v<T> ? nullptr : p.clearCells;
+  const bool clearBelow = segmentsClearBelow(p.preint);
+  auto frontClear = [&](float node) __attribute__((always_inline)) {
+    const float x = std::fma(node, p.preint.scale, p.preint.offset);  // as allClear() computes it
+    return clearBelow ? x < p.preint.clearBelow : x >= p.preint.clearAbove;
+  };
+  // The cells of samples first .. first + 7 (as aroundBatch() finds them) all clear.
+  auto cellsClear = [&](std::int64_t first) __attribute__((always_inline)) {
+    const __m256 k = _mm256_add_ps(_mm256_set1_ps(float(first)), _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7));
+    __m256i cell[3];
+    for (int a = 0; a < 3; ++a) {
+      const __m256 u = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(k, d[a], o[a]), _mm256_setzero_ps()),
+                                     _mm256_set1_ps(p.domainMax[a]));
+      cell[a] = clampCells8(u, p.storedCellLo[a], p.storedCellHi[a]);
+    }
+    return allCellsClear8(clearCells, voxelIndex8(IndexLanes<kShifted>(p), cell[0], cell[1], cell[2]));
+  };
 #endif
   using Cells = std::false_type;
   // The batches, with rows or cells (two loops, the choice made once).
@@ -380,11 +396,29 @@ inline bool runPreintegratedIndexed(const KernelParams& p, const RaySetup& ray, 
     // past `exit` would read inside the stored box as well.
     __m256 nextLo, nextHi;
     __m256 nextAfter = aroundBatch<T, kShifted>(v, p, o, d, start + 2, nextLo, nextHi);
+#ifdef PVR_HAVE_PREINT_LANES
+    bool skip = false;  // batch s lies in clear cells: its samples were not read
+#endif
     for (std::int64_t s = start; s + kFullBatchesOnly < exit; s += 8) {
+#ifdef PVR_HAVE_PREINT_LANES
+      if (skip) {
+        if (s + 8 >= exit) exit = more(exit);
+        const int count = int(std::min<std::int64_t>(8, exit - s));
+        samples += std::uint64_t(count);
+        start = s + count;
+        frontStale = true;
+        // Its last node, the next batch's front, lies in a clear cell too.
+        skip = s + 8 < exit && cellsClear(s + 9);
+        if (!skip && s + 8 < exit) {
+          frontNode = openWindow(s + 8);
+          nextAfter = aroundBatch<T, kShifted>(v, p, o, d, s + 10, nextLo, nextHi);
+        }
+        continue;
+      }
+#endif
       // The samples at s + 2 .. s + 9 (after), and at s .. s + 7 and s + 1 .. s + 8.
       const __m256 after = nextAfter, lo8 = nextLo, hi8 = nextHi;
       if (s + 8 >= exit) exit = more(exit);
-      if (s + 8 + kFullBatchesOnly < exit) nextAfter = aroundBatch<T, kShifted>(v, p, o, d, s + 10, nextLo, nextHi);
       const __m256 before8 = shifted(carried, after, kTwo{}), at = shifted(carried, after, kOne{});
       const __m256 bend = _mm256_add_ps(_mm256_sub_ps(before8, _mm256_add_ps(at, at)), after);
       __m256 node = _mm256_sub_ps(at, _mm256_mul_ps(bend, _mm256_set1_ps(1.0f / 12.0f)));
@@ -404,10 +438,15 @@ inline bool runPreintegratedIndexed(const KernelParams& p, const RaySetup& ray, 
         node = _mm256_and_ps(node, finite8(node));
         valid &= unsigned(_mm256_movemask_ps(_mm256_and_ps(finite8(before8), finite8(at))));
       }
+      // The next batch: skipped (its front is this batch's last node; the
+      // cells are read only after a clear front), or its samples fetched
+      // before this batch's empty test.
+      const float nextFront = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(node, _mm256_set1_epi32(7)));
+      skip = clearCells && s + 8 < exit && frontClear(nextFront) && cellsClear(s + 9);
+      if (!skip && s + 8 < exit) nextAfter = aroundBatch<T, kShifted>(v, p, o, d, s + 10, nextLo, nextHi);
       // A batch whose nodes all lie in empty cells integrates nothing: skip
       // the table, count the samples; the front end is looked up again only
       // when a batch needs it.
-      const float nextFront = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(node, _mm256_set1_epi32(7)));
       if (preint::allClear(p.preint, node, frontNode) ||
           (p.preint.gaps && preint::allEmpty(p.preint, node, frontNode))) {
         frontStale = true;
@@ -490,6 +529,7 @@ inline bool runPreintegratedIndexed(const KernelParams& p, const RaySetup& ray, 
         acc.addBehind(c);
       }
 #else
+      if (s + 8 + kFullBatchesOnly < exit) nextAfter = aroundBatch<T, kShifted>(v, p, o, d, s + 10, nextLo, nextHi);
       alignas(32) float back[8], raw[9];
       _mm256_store_ps(back, node);
       _mm256_storeu_ps(raw, before8);

@@ -99,15 +99,13 @@ void BrickRenderer::classify(const TransferFunctionSpec& tf, const RenderOptions
   preintegrated_.reset();
   if (options.preintegrated) preintegrated_ = std::make_unique<PreintegratedTable>(tf);
   macrocells_.classify(table_, options.skipEmpty, pool);
-  // Only plain batches read the clear cells: pre-integrated segments
-  // integrate between samples, and would not skip by them.
-  clearCells_ = ClearCells();
-  if (!options.preintegrated) {
-    KernelParams byTable;
-    setBrick(byTable, brick_, macrocells_);
-    setTables(byTable, table_, nullptr, options.step);
-    clearCells_.build(byTable, brick_, pool);
-  }
+  // The clear cells of the table the batches read: each plain sample's,
+  // or the segments' one end (clear_cells.h).
+  KernelParams byTable;
+  setBrick(byTable, brick_, macrocells_);
+  setTables(byTable, table_, preintegrated_.get(), options.step);
+  clearCells_.build(preintegrated_ ? ClearEnds::ofSegments(byTable.preint) : ClearEnds::ofSamples(byTable), byTable,
+                    brick_, pool);
   classifiedStep_ = options.step;
 }
 

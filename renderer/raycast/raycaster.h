@@ -105,7 +105,7 @@ class BrickRenderer {
   // stays) and one table per level; empty tables when it is off.
   std::unique_ptr<StepLevels> levels_;
   std::vector<TransferTable> levelTables_;
-  ClearCells clearCells_;  // of table_ (plain batches)
+  ClearCells clearCells_;  // of table_, or of preintegrated_ when there is one
   double classifiedStep_ = 0;
   std::optional<WorldRegion> region_;
 };

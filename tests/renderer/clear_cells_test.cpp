@@ -1,8 +1,9 @@
 // Clear cells (renderer/raycast/clear_cells.h): the cells whose samples all
-// classify as transparent, which the batched kernel skips before reading a
-// voxel. Which cells are marked, and that the skip leaves every image bit
-// for bit as it was: an integer brick (with clear cells) renders exactly as
-// its float copy (float bricks have none) does.
+// classify as transparent, which the batched kernels (plain and
+// pre-integrated) skip before reading a voxel. Which cells are marked, and
+// that the skip leaves every image bit for bit as it was: an integer brick
+// (with clear cells) renders exactly as its float copy (float bricks have
+// none) does.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -19,8 +20,6 @@
 
 namespace pvr::core {
 namespace {
-
-
 
 // Integer node values on 40^3 nodes: 0 around, a soft blob of up to 120 in
 // the middle and a speck of 250 at the eight nodes of cell (30, 8, 30).
@@ -46,14 +45,16 @@ bool clearCell(const ClearCells& cells, std::int64_t n, int i, int j, int k) {
   return (cells.bits()[at >> 3] >> (at & 7)) & 1;
 }
 
-ClearCells clearCellsOf(const Brick& brick, const TransferFunctionSpec& tf) {
+// The clear cells of plain samples, or of pre-integrated segments.
+ClearCells clearCellsOf(const Brick& brick, const TransferFunctionSpec& tf, bool segments = false) {
   const MacrocellGrid macrocells(brick);
   const TransferTable table(tf, 0.5);
+  const PreintegratedTable integrals(tf);
   KernelParams p;
   setBrick(p, brick, macrocells);
-  setTables(p, table, nullptr, 0.5);
+  setTables(p, table, segments ? &integrals : nullptr, 0.5);
   ClearCells cells;
-  cells.build(p, brick, &pool());
+  cells.build(segments ? ClearEnds::ofSegments(p.preint) : ClearEnds::ofSamples(p), p, brick, &pool());
   return cells;
 }
 
@@ -77,6 +78,22 @@ TEST_CASE("a cell is clear when its eight nodes all lie in one transparent end o
   CHECK_FALSE(clearCell(blob, 40, 20, 19, 21));  // the blob's middle is visible
 }
 
+TEST_CASE("segments' clear cells mark one transparent end, the low one") {
+  const Brick brick = makeVolume(cubeGrid(40), ScalarType::kUInt8, speckAndBlob);
+  // A segment from the ground (low end) into the speck (high end) crosses the visible middle.
+  const ClearCells blob = clearCellsOf(brick, blobOnly(), true);
+  REQUIRE(blob.bits() != nullptr);
+  CHECK(clearCell(blob, 40, 0, 0, 0));
+  CHECK_FALSE(clearCell(blob, 40, 30, 8, 30));  // the high end: not marked
+  CHECK_FALSE(clearCell(blob, 40, 20, 19, 21));
+  // Only a high end: it is marked.
+  const ClearCells high = clearCellsOf(brick, transfer({{0, 0.2, 0.5, 0.9, 0.3}, {130, 0.4, 0.8, 0.6, 0.3},
+                                                         {200, 0, 0, 0, 0}, {255, 0, 0, 0, 0}}), true);
+  REQUIRE(high.bits() != nullptr);
+  CHECK(clearCell(high, 40, 30, 8, 30));
+  CHECK_FALSE(clearCell(high, 40, 0, 0, 0));
+}
+
 TEST_CASE("no clear cells for a float brick or a table without a transparent end") {
   const Brick floats = makeVolume(cubeGrid(24), ScalarType::kFloat32, speckAndBlob);
   CHECK(clearCellsOf(floats, speckOnly()).bits() == nullptr);
@@ -94,27 +111,28 @@ TEST_CASE("skipping clear cells leaves the image bit for bit as it was") {
     const Brick integers = makeVolume(grid, type, speckAndBlob);
     const Brick floats = makeVolume(grid, ScalarType::kFloat32, speckAndBlob);
     for (const TransferFunctionSpec& tf : {speckOnly(), blobOnly()})
-      for (const bool shaded : {false, true})
-        for (const double step : {0.5, 1.0}) {
-          RenderOptions options = makeOptions(step, false, shaded);
-          BrickRenderer withCells(integers), without(floats);
-          withCells.classify(tf, options, &pool());
-          without.classify(tf, options, &pool());
-          for (const Camera& camera : cameras) {
-            RenderStats a, b;
-            const Image x = withCells.render(camera, options, pool(), &a).toFullFrame();
-            const Image y = without.render(camera, options, pool(), &b).toFullFrame();
-            CAPTURE(int(type), shaded, step);
-            CHECK(a.samples == b.samples);
-            int differing = 0;
-            for (std::size_t n = 0; n < x.pixels().size(); ++n) {
-              const Rgba& s = x.pixels()[n];
-              const Rgba& t = y.pixels()[n];
-              differing += s.r != t.r || s.g != t.g || s.b != t.b || s.a != t.a;
+      for (const bool preintegrated : {false, true})
+        for (const bool shaded : {false, true})
+          for (const double step : {0.5, 1.0}) {
+            RenderOptions options = makeOptions(step, preintegrated, shaded);
+            BrickRenderer withCells(integers), without(floats);
+            withCells.classify(tf, options, &pool());
+            without.classify(tf, options, &pool());
+            for (const Camera& camera : cameras) {
+              RenderStats a, b;
+              const Image x = withCells.render(camera, options, pool(), &a).toFullFrame();
+              const Image y = without.render(camera, options, pool(), &b).toFullFrame();
+              CAPTURE(int(type), preintegrated, shaded, step);
+              CHECK(a.samples == b.samples);
+              int differing = 0;
+              for (std::size_t n = 0; n < x.pixels().size(); ++n) {
+                const Rgba& s = x.pixels()[n];
+                const Rgba& t = y.pixels()[n];
+                differing += s.r != t.r || s.g != t.g || s.b != t.b || s.a != t.a;
+              }
+              CHECK(differing == 0);
             }
-            CHECK(differing == 0);
           }
-        }
   }
 }
 
