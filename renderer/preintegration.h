@@ -90,10 +90,21 @@ struct PreintegralTables {
   bool gaps = true;  // empty cells between the first visible cell and the last
 };
 
+// The empty end a scalar's table coordinate lies in (below clearBelow, at
+// or above clearAbove, or neither; NaN: neither), the coordinate computed
+// as preint::allClear() computes it.
+enum class EmptyEnd { kNone, kLow, kHigh };
+inline EmptyEnd emptyEndOf(const PreintegralTables& t, float scalar) {
+  const float x = std::fma(scalar, t.scale, t.offset);
+  return x < t.clearBelow ? EmptyEnd::kLow : x >= t.clearAbove ? EmptyEnd::kHigh : EmptyEnd::kNone;
+}
+
 // The one empty end whose cells pre-integrated batches skip by (ClearEnds::
 // ofSegments, clear_cells.h), the low one where the table has one: a
 // segment from one end to the other crosses the visible values between.
-inline bool segmentsClearBelow(const PreintegralTables& t) { return t.clearBelow > -INFINITY; }
+inline EmptyEnd segmentsClearEnd(const PreintegralTables& t) {
+  return t.clearBelow > -INFINITY ? EmptyEnd::kLow : EmptyEnd::kHigh;
+}
 
 namespace preint {
 

@@ -108,7 +108,7 @@ ClearEnds ClearEnds::ofSamples(const KernelParams& p) { return {p.tableScale, p.
 ClearEnds ClearEnds::ofSegments(const PreintegralTables& t) {
   // Infinite ends (none, or every coordinate) as the finite bounds plain
   // tables use.
-  if (segmentsClearBelow(t)) return {t.scale, t.offset, std::min(t.clearBelow, FLT_MAX), FLT_MAX};
+  if (segmentsClearEnd(t) == EmptyEnd::kLow) return {t.scale, t.offset, std::min(t.clearBelow, FLT_MAX), FLT_MAX};
   return {t.scale, t.offset, -FLT_MAX, std::min(t.clearAbove, FLT_MAX)};
 }
 

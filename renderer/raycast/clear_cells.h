@@ -46,7 +46,7 @@ struct ClearEnds {
   // each sample is classified on its own.
   static ClearEnds ofSamples(const KernelParams& p);
   // One end of a pre-integrated table (PreintegralTables::clearBelow,
-  // clearAbove), the low one where it has one (segmentsClearBelow()).
+  // clearAbove), the low one where it has one (segmentsClearEnd()).
   static ClearEnds ofSegments(const PreintegralTables& t);
 };
 

@@ -201,16 +201,14 @@ inline bool runBatched(const KernelParams& p, const RaySetup& ray, std::int64_t&
   return runBatchedIndexed<T, kShaded, kPower, false>(p, ray, start, exit, acc, samples, std::forward<More>(more));
 }
 
-// The scalars at samples [first, first + 8) as `around` reads them
-// (positions clamped into the domain, cells into the stored box): a
-// pre-integrated segment's ends may lie beyond the owned box. `lo` and
-// `hi` get the ranges of their cells' nodes (aroundRange()).
-template <typename T, bool kShifted = false>
-[[gnu::always_inline]] inline __m256 aroundBatch(const T* v, const KernelParams& p, const __m256 o[3],
-                                                 const __m256 d[3], std::int64_t first, __m256& lo,
-                                                 __m256& hi) {
+// The voxel indices of the cells of samples [first, first + 8) as `around`
+// finds them (positions clamped into the domain, cells into the stored
+// box: a pre-integrated segment's ends may lie beyond the owned box), and
+// the positions' fractions in them (f).
+template <bool kShifted = false>
+[[gnu::always_inline]] inline __m256i aroundCells8(const KernelParams& p, const __m256 o[3], const __m256 d[3],
+                                                   std::int64_t first, __m256 f[3]) {
   const __m256 k = _mm256_add_ps(_mm256_set1_ps(float(first)), _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7));
-  __m256 f[3];
   __m256i cell[3];
   for (int a = 0; a < 3; ++a) {
     const __m256 u = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(k, d[a], o[a]), _mm256_setzero_ps()),
@@ -218,9 +216,19 @@ template <typename T, bool kShifted = false>
     cell[a] = clampCells8(u, p.storedCellLo[a], p.storedCellHi[a]);
     f[a] = _mm256_sub_ps(u, _mm256_cvtepi32_ps(cell[a]));
   }
+  return voxelIndex8(IndexLanes<kShifted>(p), cell[0], cell[1], cell[2]);
+}
+
+// The scalars at samples [first, first + 8) as `around` reads them
+// (aroundCells8); `lo` and `hi` get the ranges of their cells' nodes
+// (aroundRange()).
+template <typename T, bool kShifted = false>
+[[gnu::always_inline]] inline __m256 aroundBatch(const T* v, const KernelParams& p, const __m256 o[3],
+                                                 const __m256 d[3], std::int64_t first, __m256& lo,
+                                                 __m256& hi) {
+  __m256 f[3];
   alignas(32) std::int32_t index[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(index),
-                     voxelIndex8(IndexLanes<kShifted>(p), cell[0], cell[1], cell[2]));
+  _mm256_store_si256(reinterpret_cast<__m256i*>(index), aroundCells8<kShifted>(p, o, d, first, f));
   __m256 a0, a1, b0, b1, c0, c1, e0, e1;
   loadPairs8(v, index, 0, a0, a1);
   loadPairs8(v, index, p.strideY, b0, b1);
@@ -368,21 +376,11 @@ inline bool runPreintegratedIndexed(const KernelParams& p, const RaySetup& ray, 
   // reopens at the next batch that is not skipped, as a call from there
   // would open it (the same samples and nodes, so the same bits).
   const std::uint8_t* clearCells = std::is_floating_point_v<T> ? nullptr : p.clearCells;
-  const bool clearBelow = segmentsClearBelow(p.preint);
-  auto frontClear = [&](float node) __attribute__((always_inline)) {
-    const float x = std::fma(node, p.preint.scale, p.preint.offset);  // as allClear() computes it
-    return clearBelow ? x < p.preint.clearBelow : x >= p.preint.clearAbove;
-  };
+  const EmptyEnd clearEnd = segmentsClearEnd(p.preint);
   // The cells of samples first .. first + 7 (as aroundBatch() finds them) all clear.
   auto cellsClear = [&](std::int64_t first) __attribute__((always_inline)) {
-    const __m256 k = _mm256_add_ps(_mm256_set1_ps(float(first)), _mm256_setr_ps(0, 1, 2, 3, 4, 5, 6, 7));
-    __m256i cell[3];
-    for (int a = 0; a < 3; ++a) {
-      const __m256 u = _mm256_min_ps(_mm256_max_ps(_mm256_fmadd_ps(k, d[a], o[a]), _mm256_setzero_ps()),
-                                     _mm256_set1_ps(p.domainMax[a]));
-      cell[a] = clampCells8(u, p.storedCellLo[a], p.storedCellHi[a]);
-    }
-    return allCellsClear8(clearCells, voxelIndex8(IndexLanes<kShifted>(p), cell[0], cell[1], cell[2]));
+    __m256 f[3];
+    return allCellsClear8(clearCells, aroundCells8<kShifted>(p, o, d, first, f));
   };
 #endif
   using Cells = std::false_type;
@@ -442,7 +440,7 @@ inline bool runPreintegratedIndexed(const KernelParams& p, const RaySetup& ray, 
       // cells are read only after a clear front), or its samples fetched
       // before this batch's empty test.
       const float nextFront = _mm256_cvtss_f32(_mm256_permutevar8x32_ps(node, _mm256_set1_epi32(7)));
-      skip = clearCells && s + 8 < exit && frontClear(nextFront) && cellsClear(s + 9);
+      skip = clearCells && s + 8 < exit && emptyEndOf(p.preint, nextFront) == clearEnd && cellsClear(s + 9);
       if (!skip && s + 8 < exit) nextAfter = aroundBatch<T, kShifted>(v, p, o, d, s + 10, nextLo, nextHi);
       // A batch whose nodes all lie in empty cells integrates nothing: skip
       // the table, count the samples; the front end is looked up again only

@@ -423,10 +423,9 @@ inline RowEnd rowEnd(const PreintegralTables& t, float scalar) {
 // mostly there; the table look-up it spares sat on the batch's chain of
 // dependent loads.
 inline RowEnd frontRow(const PreintegralTables& t, float scalar) {
-  const float at = std::fma(scalar, t.scale, t.offset);  // as allClear() computes it
-  const bool low = at < t.clearBelow, high = at >= t.clearAbove;  // neither for NaN
-  if (!low && !high) return rowEnd(t, scalar);
-  const __m512d row = low ? _mm512_setzero_pd() : _mm512_load_pd(t.rows[t.entries - 1].value);
+  const EmptyEnd end = emptyEndOf(t, scalar);
+  if (end == EmptyEnd::kNone) return rowEnd(t, scalar);
+  const __m512d row = end == EmptyEnd::kLow ? _mm512_setzero_pd() : _mm512_load_pd(t.rows[t.entries - 1].value);
   return {row, _mm512_cvtsd_f64(coordinates(t, _mm256_set1_ps(scalar)).x)};
 }
 
