@@ -26,79 +26,162 @@ std::uint8_t nodeClass(T v, const ClearEnds& ends) {
   return std::uint8_t((x + margin < double(ends.below) ? 1 : 0) | (x - margin >= double(ends.above) ? 2 : 0));
 }
 
-inline void orInto(std::vector<std::uint64_t>& bits, std::int64_t word, std::uint64_t value) {
-  if (value) __atomic_fetch_or(&bits[std::size_t(word)], value, __ATOMIC_RELAXED);
+inline void orInto(std::vector<std::uint64_t>& bits, std::int64_t word, std::uint64_t value, bool shared) {
+  if (!value) return;
+  if (shared) __atomic_fetch_or(&bits[std::size_t(word)], value, __ATOMIC_RELAXED);
+  else bits[std::size_t(word)] |= value;
 }
 
+// Sets the bits of `cells` (bit n: cell at + n) in the row `to`.
+inline void setCells(std::uint64_t* to, int at, std::uint64_t cells) {
+  to[at >> 6] |= cells << (at & 63);
+  const std::uint64_t spill = (at & 63) ? cells >> (64 - (at & 63)) : 0;
+  if (spill) to[(at >> 6) + 1] |= spill;
+}
+
+// Ors the `width` bits of a row of cells into `bits` from bit `at` on. The
+// words strictly inside the row hold its bits alone; its first and last
+// may hold another row's, which another thread may be writing, so they are
+// or-ed atomically.
+inline void orRow(std::vector<std::uint64_t>& bits, std::int64_t at, const std::uint64_t* cells, int width) {
+  const std::int64_t first = at >> 6, last = (at + width - 1) >> 6;
+  const int shift = int(at & 63);
+  for (std::int64_t w = 0; w < (width + 63) / 64; ++w) {
+    const std::int64_t word = first + w;
+    orInto(bits, word, cells[w] << shift, word == first || word == last);
+    if (shift && word + 1 <= last) orInto(bits, word + 1, cells[w] >> (64 - shift), word + 1 == last);
+  }
+}
+
+// How a block of cells stands against the ends, from its nodes' bounds.
+enum class Block : std::uint8_t { kNoneClear, kAllClear, kRead };
+
 template <typename T>
-void buildTyped(const ClearEnds& ends, const KernelParams& p, std::vector<std::uint64_t>& bits, ThreadPool* pool) {
+void buildTyped(const ClearEnds& ends, const KernelParams& p, const MacrocellBounds* bounds,
+                std::vector<std::uint64_t>& bits, ThreadPool* pool) {
   const T* v = static_cast<const T*>(p.voxels);
   // nodeClass of every value of T (8 or 16 bits), by its offset from the least.
   constexpr std::int64_t kLeast = std::numeric_limits<T>::min();
   std::vector<std::uint8_t> classOf(std::size_t(1) << (8 * sizeof(T)));
   for (std::size_t n = 0; n < classOf.size(); ++n) classOf[n] = nodeClass(T(kLeast + std::int64_t(n)), ends);
   const std::uint8_t* cls = classOf.data();
-  const int i0 = p.storedCellLo[0], j0 = p.storedCellLo[1], k0 = p.storedCellLo[2];
-  const std::size_t width = std::size_t(p.storedCellHi[0] - i0 + 2);   // nodes of a row
-  const std::size_t height = std::size_t(p.storedCellHi[1] - j0 + 2);  // rows of a plane
-  const int planes = p.storedCellHi[2] - k0 + 1;                        // planes of cells
-  // A plane of cells from its two planes of nodes: each node classified
-  // once a plane (the and of a row's node with its x neighbour, then of a
-  // row with the next, then of a plane with the next), so a slab of planes
-  // costs a table look-up a node.
-  auto squares = [&](int k, std::vector<std::uint8_t>& out) {  // the and of each 2x2 of nodes of plane k
-    // Locals, not the lambda's captures: the byte stores below may alias
-    // anything, so captured values would be loaded again at every store.
-    const std::size_t n = width;
-    std::vector<std::uint8_t> rows(2 * n);
-    std::uint8_t* row = rows.data();
-    std::uint8_t* previous = row + n;
-    const std::uint8_t* classes = cls;
-    for (std::size_t j = 0; j < height; ++j) {
-      const T* nodes = v + (p.base + i0 + std::int64_t(j0 + std::int64_t(j)) * p.strideY + std::int64_t(k) * p.strideZ);
-      for (std::size_t i = 0; i < n; ++i) row[i] = classes[std::int64_t(nodes[i]) - kLeast];
-      for (std::size_t i = 0; i + 1 < n; ++i) row[i] &= row[i + 1];
-      if (j > 0) {
-        std::uint8_t* square = out.data() + (j - 1) * n;
-        for (std::size_t i = 0; i + 1 < n; ++i) square[i] = previous[i] & row[i];
-      }
-      std::swap(row, previous);
+  auto classOfValue = [cls](T value) { return cls[std::int64_t(value) - kLeast]; };
+  constexpr int kShift = MacrocellLayout::kShift, kSize = MacrocellLayout::kSize;
+  const int lo[3] = {p.storedCellLo[0], p.storedCellLo[1], p.storedCellLo[2]};
+  const int hi[3] = {p.storedCellHi[0], p.storedCellHi[1], p.storedCellHi[2]};
+  // Blocks of kSize^3 cells aligned as macrocells are, over the stored cells.
+  int firstBlock[3], blocks[3];
+  for (int a = 0; a < 3; ++a) {
+    firstBlock[a] = lo[a] >> kShift;
+    blocks[a] = (hi[a] >> kShift) - firstBlock[a] + 1;
+  }
+  // A block that is one of the brick's macrocells, all of whose stored
+  // cells the brick owns, takes its class from the macrocell's node bounds
+  // (macrocell_bounds.h). The ends are half-lines of values (the table
+  // coordinate is linear in the value), so the nodes all lie in one end
+  // when the least and the greatest both do, and none does when neither
+  // does. Every other block (ghost cells, no bounds) is read node by node.
+  auto blockOf = [&](int bx, int by, int bz) {
+    if (!bounds) return Block::kRead;
+    const int b[3] = {bx, by, bz};
+    const MacrocellLayout& layout = bounds->layout();
+    std::int64_t index = 0;
+    for (int a = 2; a >= 0; --a) {
+      const std::int64_t m = b[a] - layout.first[a];
+      const bool owned = std::max(b[a] * kSize, lo[a]) >= p.ownCellLo[a] &&
+                         std::min(b[a] * kSize + kSize - 1, hi[a]) <= p.ownCellHi[a];
+      if (m < 0 || m >= layout.count[a] || !owned) return Block::kRead;
+      index = index * layout.count[a] + m;
     }
+    const std::uint8_t least = classOfValue(bounds->min<T>()[index]);
+    const std::uint8_t greatest = classOfValue(bounds->max<T>()[index]);
+    return (least & greatest) ? Block::kAllClear : (least | greatest) ? Block::kRead : Block::kNoneClear;
   };
-  // Slabs of planes over the pool; a word of bits two slabs share is or-ed
-  // in atomically.
-  const int slabs = std::max(1, std::min(planes, 64));
-  auto slab = [&](int first, int end) {
-    std::vector<std::uint8_t> below(width * height), above(width * height);
-    squares(k0 + first, below);
-    for (int k = k0 + first; k < k0 + end; ++k) {
-      squares(k + 1, above);
-      for (std::size_t j = 0; j + 1 < height; ++j) {
-        const std::int64_t row = p.base + i0 + std::int64_t(j0 + std::int64_t(j)) * p.strideY + std::int64_t(k) * p.strideZ;
-        const std::uint8_t* a = &below[j * width];
-        const std::uint8_t* b = &above[j * width];
-        // The row's bits gathered a 64-bit word at a time, without a branch
-        // on the cells (which are clear and which not is not predictable).
-        std::uint64_t word = 0;
-        std::int64_t at = row;  // the bit of cell i
-        for (std::size_t i = 0; i + 1 < width; ++i, ++at) {
-          word |= std::uint64_t((a[i] & b[i]) != 0) << (at & 63);
-          if ((at & 63) == 63) {
-            orInto(bits, at >> 6, word);
-            word = 0;
+  const int width = hi[0] - lo[0] + 1;  // cells of a row
+  const std::size_t words = std::size_t(width + 63) / 64;
+  // One plane of blocks: its rows of blocks one by one, the bits of their
+  // kSize^2 rows of cells gathered in `rows` and or-ed into `bits` a row
+  // at a time (orRow). A row of blocks none of which has a clear cell
+  // costs its blocks' bounds alone.
+  auto plane = [&](int bz) {
+    std::vector<std::uint64_t> rows(words * kSize * kSize), allClear(words);
+    std::vector<Block> row(static_cast<std::size_t>(blocks[0]));
+    struct NodeMasks {
+      std::uint32_t low[kSize + 1][kSize + 1], high[kSize + 1][kSize + 1];
+    };
+    std::vector<int> reads;  // the row's blocks read node by node
+    std::vector<NodeMasks> masks;
+    auto cellsOf = [&](int n, int& x0, int& x1) {  // the stored cells of the row's block n along x
+      x0 = std::max(lo[0], (firstBlock[0] + n) * kSize);
+      x1 = std::min(hi[0], (firstBlock[0] + n) * kSize + kSize - 1);
+    };
+    const int z0 = std::max(lo[2], bz * kSize), z1 = std::min(hi[2], bz * kSize + kSize - 1);
+    for (int by = firstBlock[1]; by < firstBlock[1] + blocks[1]; ++by) {
+      const int y0 = std::max(lo[1], by * kSize), y1 = std::min(hi[1], by * kSize + kSize - 1);
+      bool any = false;
+      for (int n = 0; n < blocks[0]; ++n) {
+        row[std::size_t(n)] = blockOf(firstBlock[0] + n, by, bz);
+        any |= row[std::size_t(n)] != Block::kNoneClear;
+      }
+      if (!any) continue;
+      std::fill(allClear.begin(), allClear.end(), 0);
+      for (int n = 0; n < blocks[0]; ++n) {
+        if (row[std::size_t(n)] != Block::kAllClear) continue;
+        int x0, x1;
+        cellsOf(n, x0, x1);
+        setCells(allClear.data(), x0 - lo[0], (std::uint64_t(1) << (x1 - x0 + 1)) - 1);
+      }
+      for (int r = 0; r < kSize * kSize; ++r)
+        std::copy(allClear.begin(), allClear.end(), rows.begin() + std::ptrdiff_t(std::size_t(r) * words));
+      // The nodes of the blocks read, a row of a block's nodes as two masks
+      // (bit x: node x0 + x lies in the low end, in the high end), taken
+      // a row of nodes across every block at a time, so that the reads run
+      // forwards through memory; a cell is clear when its eight nodes
+      // share an end.
+      reads.clear();
+      for (int n = 0; n < blocks[0]; ++n)
+        if (row[std::size_t(n)] == Block::kRead) reads.push_back(n);
+      masks.resize(reads.size());
+      for (int z = z0; z <= z1 + 1; ++z)
+        for (int y = y0; y <= y1 + 1; ++y) {
+          const T* nodes = v + (p.base + std::int64_t(y) * p.strideY + std::int64_t(z) * p.strideZ);
+          for (std::size_t r = 0; r < reads.size(); ++r) {
+            int x0, x1;
+            cellsOf(reads[r], x0, x1);
+            std::uint32_t l = 0, h = 0;
+            for (int x = 0; x <= x1 - x0 + 1; ++x) {
+              const std::uint32_t c = classOfValue(nodes[x0 + x]);
+              l |= (c & 1u) << x;
+              h |= (c >> 1) << x;
+            }
+            masks[r].low[z - z0][y - y0] = l;
+            masks[r].high[z - z0][y - y0] = h;
           }
         }
-        orInto(bits, (at - 1) >> 6, word);
+      for (std::size_t r = 0; r < reads.size(); ++r) {
+        int x0, x1;
+        cellsOf(reads[r], x0, x1);
+        const NodeMasks& m = masks[r];
+        const std::uint32_t cellsOfRow = (1u << (x1 - x0 + 1)) - 1;
+        for (int z = 0; z <= z1 - z0; ++z)
+          for (int y = 0; y <= y1 - y0; ++y) {
+            const std::uint32_t l = m.low[z][y] & m.low[z][y + 1] & m.low[z + 1][y] & m.low[z + 1][y + 1];
+            const std::uint32_t h = m.high[z][y] & m.high[z][y + 1] & m.high[z + 1][y] & m.high[z + 1][y + 1];
+            const int at = (z0 - bz * kSize + z) * kSize + (y0 - by * kSize + y);
+            setCells(rows.data() + std::size_t(at) * words, x0 - lo[0], ((l & (l >> 1)) | (h & (h >> 1))) & cellsOfRow);
+          }
       }
-      std::swap(below, above);
+      for (int z = z0; z <= z1; ++z)
+        for (int y = y0; y <= y1; ++y) {
+          const std::uint64_t* cells = rows.data() + std::size_t((z - bz * kSize) * kSize + (y - by * kSize)) * words;
+          orRow(bits, p.base + lo[0] + std::int64_t(y) * p.strideY + std::int64_t(z) * p.strideZ, cells, width);
+        }
     }
   };
-  auto run = [&](std::size_t n) { slab(int(std::int64_t(planes) * std::int64_t(n) / slabs),
-                                       int(std::int64_t(planes) * std::int64_t(n + 1) / slabs)); };
   if (pool)
-    pool->parallelFor(std::size_t(slabs), [&](std::size_t n, int) { run(n); });
+    pool->parallelFor(std::size_t(blocks[2]), [&](std::size_t n, int) { plane(firstBlock[2] + int(n)); });
   else
-    for (int n = 0; n < slabs; ++n) run(std::size_t(n));
+    for (int n = 0; n < blocks[2]; ++n) plane(firstBlock[2] + n);
 }
 
 }  // namespace
@@ -112,7 +195,8 @@ ClearEnds ClearEnds::ofSegments(const PreintegralTables& t) {
   return {t.scale, t.offset, -FLT_MAX, std::min(t.clearAbove, FLT_MAX)};
 }
 
-void ClearCells::build(const ClearEnds& ends, const KernelParams& p, const Brick& brick, ThreadPool* pool) {
+void ClearCells::build(const ClearEnds& ends, const KernelParams& p, const Brick& brick,
+                       const MacrocellBounds* bounds, ThreadPool* pool) {
   bits_.clear();
   const IVec3 extents = brick.stored().extents();
   const bool cells = extents.x > 1 && extents.y > 1 && extents.z > 1;
@@ -122,9 +206,9 @@ void ClearCells::build(const ClearEnds& ends, const KernelParams& p, const Brick
   // A bit a node, and 4 bytes more: broadcastWords8 reads 4 from a lane's byte on.
   bits_.assign(std::size_t(brick.stored().nodeCount() / 64 + 2), 0);
   switch (brick.type()) {
-    case ScalarType::kUInt8: buildTyped<std::uint8_t>(ends, p, bits_, pool); break;
-    case ScalarType::kUInt16: buildTyped<std::uint16_t>(ends, p, bits_, pool); break;
-    case ScalarType::kInt16: buildTyped<std::int16_t>(ends, p, bits_, pool); break;
+    case ScalarType::kUInt8: buildTyped<std::uint8_t>(ends, p, bounds, bits_, pool); break;
+    case ScalarType::kUInt16: buildTyped<std::uint16_t>(ends, p, bounds, bits_, pool); break;
+    case ScalarType::kInt16: buildTyped<std::int16_t>(ends, p, bounds, bits_, pool); break;
     case ScalarType::kFloat32: break;
   }
 }

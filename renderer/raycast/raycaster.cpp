@@ -105,7 +105,7 @@ void BrickRenderer::classify(const TransferFunctionSpec& tf, const RenderOptions
   setBrick(byTable, brick_, macrocells_);
   setTables(byTable, table_, preintegrated_.get(), options.step);
   clearCells_.build(preintegrated_ ? ClearEnds::ofSegments(byTable.preint) : ClearEnds::ofSamples(byTable), byTable,
-                    brick_, pool);
+                    brick_, &macrocells_.bounds(), pool);
   classifiedStep_ = options.step;
 }
 

@@ -45,8 +45,10 @@ bool clearCell(const ClearCells& cells, std::int64_t n, int i, int j, int k) {
   return (cells.bits()[at >> 3] >> (at & 7)) & 1;
 }
 
-// The clear cells of plain samples, or of pre-integrated segments.
-ClearCells clearCellsOf(const Brick& brick, const TransferFunctionSpec& tf, bool segments = false) {
+// The clear cells of plain samples, or of pre-integrated segments; whole
+// macrocells decided by their bounds, or (byBounds false) every node read.
+ClearCells clearCellsOf(const Brick& brick, const TransferFunctionSpec& tf, bool segments = false,
+                        bool byBounds = true) {
   const MacrocellGrid macrocells(brick);
   const TransferTable table(tf, 0.5);
   const PreintegratedTable integrals(tf);
@@ -54,7 +56,8 @@ ClearCells clearCellsOf(const Brick& brick, const TransferFunctionSpec& tf, bool
   setBrick(p, brick, macrocells);
   setTables(p, table, segments ? &integrals : nullptr, 0.5);
   ClearCells cells;
-  cells.build(segments ? ClearEnds::ofSegments(p.preint) : ClearEnds::ofSamples(p), p, brick, &pool());
+  cells.build(segments ? ClearEnds::ofSegments(p.preint) : ClearEnds::ofSamples(p), p, brick,
+              byBounds ? &macrocells.bounds() : nullptr, &pool());
   return cells;
 }
 
@@ -92,6 +95,42 @@ TEST_CASE("segments' clear cells mark one transparent end, the low one") {
   REQUIRE(high.bits() != nullptr);
   CHECK(clearCell(high, 40, 30, 8, 30));
   CHECK_FALSE(clearCell(high, 40, 0, 0, 0));
+}
+
+TEST_CASE("macrocells decided by their bounds leave the bits every node read gives") {
+  // Odd sizes (partial macrocells at the far faces), bricks cut out of the
+  // volume at offsets that are not multiples of a macrocell, with ghost
+  // layers (stored cells outside every macrocell the brick owns).
+  GridGeometry grid;
+  grid.dims = {37, 41, 35};
+  const std::vector<std::pair<NodeBox, int>> cuts = {
+      {NodeBox{{0, 0, 0}, {36, 40, 34}}, 0}, {NodeBox{{5, 3, 0}, {30, 22, 17}}, 1}, {NodeBox{{18, 21, 17}, {36, 40, 34}}, 2}};
+  const std::vector<TransferFunctionSpec> tfs = {speckOnly(), blobOnly(),
+                                                 transfer({{0, 0.2, 0.5, 0.9, 0.3}, {100, 0.4, 0.8, 0.6, 0.3},
+                                                           {110, 0, 0, 0, 0}, {255, 0, 0, 0, 0}})};
+  std::size_t marked = 0;
+  for (const ScalarType type : {ScalarType::kUInt8, ScalarType::kUInt16, ScalarType::kInt16}) {
+    const Brick whole = makeVolume(grid, type, speckAndBlob);
+    for (const auto& [owned, ghost] : cuts) {
+      const Brick brick = ghost == 0 && owned == NodeBox{{0, 0, 0}, {36, 40, 34}} ? whole : cropBrick(whole, owned, ghost);
+      for (const TransferFunctionSpec& tf : tfs)
+        for (const bool segments : {false, true}) {
+          const ClearCells byBounds = clearCellsOf(brick, tf, segments, true);
+          const ClearCells byNodes = clearCellsOf(brick, tf, segments, false);
+          REQUIRE(byBounds.bits() != nullptr);
+          REQUIRE(byNodes.bits() != nullptr);
+          const std::size_t bytes = std::size_t(brick.stored().nodeCount() + 7) / 8;
+          std::size_t differing = 0;
+          for (std::size_t n = 0; n < bytes; ++n) {
+            differing += byBounds.bits()[n] != byNodes.bits()[n];
+            marked += std::size_t(__builtin_popcount(byNodes.bits()[n]));  // (compared bits, not all zero)
+          }
+          CAPTURE(int(type), owned.lo.x, owned.lo.y, owned.lo.z, ghost, segments);
+          CHECK(differing == 0);
+        }
+    }
+  }
+  CHECK(marked > 0);
 }
 
 TEST_CASE("no clear cells for a float brick or a table without a transparent end") {
