@@ -2,7 +2,7 @@
 #
 #   pvrsh latency.tcl -host HOST:PORT ?-frames 50? ?-ranks 2? ?-shading 1?
 #                     ?-preset TF.json? ?-size 512? ?-out DIR? ?-tag latency?
-#                     ?-interactive 0? ?-reduction 4?
+#                     ?-interactive 0? ?-reduction 4? ?-edit view?
 #
 # A photo in a label on screen receives the frames (`:s image window`). For
 # each of -frames single frames of the CT head (after 3 warm-up frames) it
@@ -16,6 +16,12 @@
 # camera turned K degrees), so every frame is new pixels; the request is
 # still one frame. Writes DIR/TAG.csv (not -name: Tk takes that one) and prints median and p90.
 #
+# With -edit tf each request is instead a transfer-function edit and a
+# frame (`set -tf ...; render frame`): the bone's points move by 0 to 40
+# Hounsfield units from request to request, so its transparent end moves
+# and every rank classifies its brick again (the clear cells included);
+# -edit colour recolours the points alone (the ends stay). The view stays.
+#
 # With -interactive 1 each request is `render rotate ... -interactive
 # -reduction R` (progressive refinement, docs/pvrsh.md): the first pixels
 # are its coarse frame's, and request-to-full-quality is its second
@@ -24,13 +30,17 @@
 package require Tk
 
 array set opt {-host "" -frames 50 -ranks 2 -shading 1 -preset "" -size 512 -out . -tag latency
-               -dataset ct_head_cranium/ct_head_cranium.json -interactive 0 -reduction 4}
+               -dataset ct_head_cranium/ct_head_cranium.json -interactive 0 -reduction 4 -edit view}
 foreach {k v} $argv {
     if {![info exists opt($k)]} {
         puts stderr "latency.tcl: unknown option $k"
         exit 2
     }
     set opt($k) $v
+}
+if {$opt(-edit) ni {view tf colour}} {
+    puts stderr "latency.tcl: -edit must be view, tf or colour, got '$opt(-edit)'"
+    exit 2
 }
 set ::pvr::progress 0
 set size $opt(-size)
@@ -75,13 +85,36 @@ proc onNotify {event args} {
     }
 }
 
-# one: a single frame at `degrees`; returns its record.
+# The bone's transfer function (examples/presets/ct_bone.json's points,
+# opacity per unit distance as the preset gives it) moved by `shift` HU, or
+# with its colours turned by `turn` (0 or 1).
+proc boneTf {shift turn} {
+    set points {}
+    foreach {s r g b a} {-1024 0 0 0 0  200 0.55 0.35 0.25 0  300 0.85 0.75 0.6 0.1
+                         1000 1 0.95 0.85 0.6  2000 1 1 1 0.9} {
+        if {$turn} {
+            lassign [list $b $r $g] r g b
+        }
+        lappend points [expr {$s == -1024 ? $s : $s + $shift}] $r $g $b $a
+    }
+    return $points
+}
+
+# one: a single frame at `degrees` (or, with -edit, the k-th edit); returns
+# its record.
 proc one {degrees} {
     set ::current {}
     set ::arrived 0
     set start [clock microseconds]
     set progressive [expr {$::opt(-interactive) ? [list -interactive -reduction $::opt(-reduction)] : {}}]
-    if {$degrees % 360 == 0} {
+    set k [expr {$degrees / 7}]
+    if {$::opt(-edit) eq "tf"} {
+        :bench set -tf [boneTf [expr {10 * ($k % 5)}] 0]
+        :bench render frame {*}$progressive
+    } elseif {$::opt(-edit) eq "colour"} {
+        :bench set -tf [boneTf 0 [expr {$k % 2}]]
+        :bench render frame {*}$progressive
+    } elseif {$degrees % 360 == 0} {
         :bench render frame {*}$progressive
     } else {
         :bench render rotate 0,0,1 $degrees,$degrees:360 {*}$progressive
@@ -174,7 +207,8 @@ set load [lindex [read $f] 0]
 close $f
 puts "PVR interactive latency: $opt(-dataset), ${size}x${size}, $n frames after 3 warm-up,\
       [dict get $status ranks] ranks, shading $opt(-shading), [exec nproc] cores, load average $load,\
-      [expr {$opt(-interactive) ? "interactive (coarse 1/$opt(-reduction) per axis, then full)" : "full frames only"}]"
+      [expr {$opt(-interactive) ? "interactive (coarse 1/$opt(-reduction) per axis, then full)" : "full frames only"}],\
+      [dict get {view "the view turning" tf "the transfer function moving" colour "the colours changing"} $opt(-edit)]"
 puts [format "request-to-first-pixels  photo median %.3f s  p90 %.3f s;  shown median %.3f s  p90 %.3f s  (target 0.05 s: %s)" \
           [percentile $firstPhoto 0.5] [percentile $firstPhoto 0.9] [percentile $firstShown 0.5] \
           [percentile $firstShown 0.9] [expr {[percentile $firstShown 0.5] <= 0.05 ? "met" : "missed"}]]

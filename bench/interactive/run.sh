@@ -9,7 +9,9 @@
 # Environment: PVR_BENCH_FRAMES (50), PVR_BENCH_RANKS (2), PVR_BENCH_SHADING (1),
 # PVR_BENCH_NAME (latency), PVR_BENCH_INTERACTIVE (0; 1: progressive renders,
 # reporting request-to-first-pixels and request-to-full-quality),
-# PVR_BENCH_REDUCTION (4: the coarse frame's pixels per axis).
+# PVR_BENCH_REDUCTION (4: the coarse frame's pixels per axis), PVR_BENCH_EDIT
+# (view: the view turns each request; tf: the transfer function moves; colour:
+# its colours change).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -39,5 +41,5 @@ run=()
 "${run[@]}" "$build/pvrsh/pvrsh" "$here/latency.tcl" -host "127.0.0.1:$port" \
   -frames "${PVR_BENCH_FRAMES:-50}" -ranks "${PVR_BENCH_RANKS:-2}" -shading "${PVR_BENCH_SHADING:-1}" \
   -preset "$root/examples/presets/ct_bone.json" -out "$out" -tag "${PVR_BENCH_NAME:-latency}" \
-  -interactive "${PVR_BENCH_INTERACTIVE:-0}" -reduction "${PVR_BENCH_REDUCTION:-4}" \
+  -interactive "${PVR_BENCH_INTERACTIVE:-0}" -reduction "${PVR_BENCH_REDUCTION:-4}" -edit "${PVR_BENCH_EDIT:-view}" \
   | tee "$out/${PVR_BENCH_NAME:-latency}.txt"

@@ -242,23 +242,31 @@ core::ImageError rgbError(const core::Image& test, const core::Image& reference)
 RebuildTimes rebuildTimes(const BenchScene& scene, int repeats, core::ThreadPool& pool) {
   const core::Scene& s = scene.scene();
   const core::TransferFunctionSpec& tf = s.volumes.front().transfer;
+  // Moved by a hundredth of its span (its transparent ends move with it),
+  // and recoloured (its ends stay): each classify below is a change.
+  core::TransferFunctionSpec moved = tf, recoloured = tf;
+  const double shift = 0.01 * (tf.points.back().scalar - tf.points.front().scalar);
+  for (core::TransferPoint& point : moved.points) point.scalar += shift;
+  for (core::TransferPoint& point : recoloured.points) point.r = 1.0 - point.r;
   core::RenderOptions options = core::renderOptionsFor(s);
   options.preintegrated = true;
   core::BrickRenderer renderer(scene.volume());
-  std::vector<double> table, classify;
+  std::vector<double> table, classify, colour;
+  auto timed = [](auto&& work) {
+    const auto started = Clock::now();
+    work();
+    return secondsSince(started);
+  };
   for (int i = 0; i < repeats; ++i) {
-    auto started = Clock::now();
-    const core::PreintegratedTable built(tf);
-    table.push_back(secondsSince(started));
-    started = Clock::now();
-    renderer.classify(tf, options, &pool);
-    classify.push_back(secondsSince(started));
+    table.push_back(timed([&] { const core::PreintegratedTable built(tf); }));
+    classify.push_back(timed([&] { renderer.classify(i % 2 ? tf : moved, options, &pool); }));
   }
+  for (int i = 0; i < repeats; ++i) colour.push_back(timed([&] { renderer.classify(i % 2 ? tf : recoloured, options, &pool); }));
   auto median = [](std::vector<double>& v) {
     std::sort(v.begin(), v.end());
     return v.empty() ? 0.0 : v[v.size() / 2];
   };
-  return {median(table), median(classify)};
+  return {median(table), median(classify), median(colour)};
 }
 
 CaseResult measureCase(const BenchScene& scene, const Case& c, const Reference& reference,

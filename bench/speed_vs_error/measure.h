@@ -132,9 +132,12 @@ core::ImageError rgbError(const core::Image& test, const core::Image& reference)
 
 // What a transfer-function change costs with pre-integration on: building
 // the pre-integration table alone, and the renderer's whole classify()
-// (both tables and the macrocells' visibility), medians of `repeats`.
+// (both tables, the macrocells' visibility and the clear cells) after a
+// change that moves the transparent ends and after one of colour alone,
+// medians of `repeats`.
 struct RebuildTimes {
   double table = 0, classify = 0;  // seconds
+  double colourClassify = 0;       // classify() after a change of colour alone (the transparent ends kept)
 };
 RebuildTimes rebuildTimes(const BenchScene& scene, int repeats, core::ThreadPool& pool);
 

@@ -195,14 +195,19 @@ ClearEnds ClearEnds::ofSegments(const PreintegralTables& t) {
   return {t.scale, t.offset, -FLT_MAX, std::min(t.clearAbove, FLT_MAX)};
 }
 
-void ClearCells::build(const ClearEnds& ends, const KernelParams& p, const Brick& brick,
+bool ClearCells::build(const ClearEnds& ends, const KernelParams& p, const Brick& brick,
                        const MacrocellBounds* bounds, ThreadPool* pool) {
+  if (builtFor_ == ends) return false;
+  builtFor_.reset();  // (until the bits are whole)
   bits_.clear();
   const IVec3 extents = brick.stored().extents();
   const bool cells = extents.x > 1 && extents.y > 1 && extents.z > 1;
   // (A table's coordinates start at 0: a low end at or below 0 marks nothing.)
   const bool transparentEnd = ends.below > 0 || ends.above < FLT_MAX;
-  if (!cells || !transparentEnd || !p.indices32 || brick.type() == ScalarType::kFloat32) return;
+  if (!cells || !transparentEnd || !p.indices32 || brick.type() == ScalarType::kFloat32) {
+    builtFor_ = ends;
+    return true;
+  }
   // A bit a node, and 4 bytes more: broadcastWords8 reads 4 from a lane's byte on.
   bits_.assign(std::size_t(brick.stored().nodeCount() / 64 + 2), 0);
   switch (brick.type()) {
@@ -211,6 +216,8 @@ void ClearCells::build(const ClearEnds& ends, const KernelParams& p, const Brick
     case ScalarType::kInt16: buildTyped<std::int16_t>(ends, p, bounds, bits_, pool); break;
     case ScalarType::kFloat32: break;
   }
+  builtFor_ = ends;
+  return true;
 }
 
 }  // namespace pvr::core

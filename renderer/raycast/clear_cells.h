@@ -33,6 +33,7 @@
 
 #include <cfloat>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "../brick.h"
@@ -50,6 +51,8 @@ struct ClearEnds {
   float scale = 0, offset = 0;
   float below = -FLT_MAX, above = FLT_MAX;
 
+  bool operator==(const ClearEnds&) const = default;
+
   // Both ends of p's plain table (KernelParams::clearBelow, clearAbove):
   // each sample is classified on its own.
   static ClearEnds ofSamples(const KernelParams& p);
@@ -65,7 +68,12 @@ class ClearCells {
   // cells or no transparent end. `bounds`: the brick's macrocell bounds
   // (MacrocellGrid::bounds()), by which whole macrocells are decided
   // without their voxels; null reads every node (the same bits).
-  void build(const ClearEnds& ends, const KernelParams& p, const Brick& brick, const MacrocellBounds* bounds,
+  // A ClearCells serves one brick, whose voxels do not change (as its
+  // BrickRenderer's macrocells assume): built again for the ends of the
+  // last build, it keeps its bits and returns false. So a transfer-function
+  // change that moves no transparent end (a colour, an opacity within the
+  // visible values) costs no bitmap.
+  bool build(const ClearEnds& ends, const KernelParams& p, const Brick& brick, const MacrocellBounds* bounds,
              ThreadPool* pool);
 
   // The bits for KernelParams::clearCells; null when there are none.
@@ -75,6 +83,7 @@ class ClearCells {
 
  private:
   std::vector<std::uint64_t> bits_;  // little-endian: bit n of the bytes is bit n % 64 of word n / 64
+  std::optional<ClearEnds> builtFor_;  // the ends bits_ were built for
 };
 
 }  // namespace pvr::core

@@ -133,6 +133,32 @@ TEST_CASE("macrocells decided by their bounds leave the bits every node read giv
   CHECK(marked > 0);
 }
 
+TEST_CASE("a transfer function that keeps the transparent ends keeps the bits") {
+  const Brick brick = makeVolume(cubeGrid(40), ScalarType::kUInt8, speckAndBlob);
+  const MacrocellGrid macrocells(brick);
+  auto build = [&](ClearCells& cells, const TransferFunctionSpec& tf) {
+    const TransferTable table(tf, 0.5);
+    KernelParams p;
+    setBrick(p, brick, macrocells);
+    setTables(p, table, nullptr, 0.5);
+    return cells.build(ClearEnds::ofSamples(p), p, brick, &macrocells.bounds(), &pool());
+  };
+  ClearCells cells;
+  REQUIRE(build(cells, blobOnly()));
+  const std::vector<std::uint8_t> before(cells.bits(), cells.bits() + 40 * 40 * 40 / 8);
+  // Other colours and opacities inside the visible values: the same ends, nothing built.
+  CHECK_FALSE(build(cells, transfer({{0, 0, 0, 0, 0}, {40, 0.9, 0.1, 0.1, 0}, {80, 0.1, 0.9, 0.1, 0.6},
+                                     {130, 0, 0, 0, 0}, {255, 0, 0, 0, 0}})));
+  CHECK(std::vector<std::uint8_t>(cells.bits(), cells.bits() + before.size()) == before);
+  // The visible values moved: built again, as a new ClearCells builds them.
+  CHECK(build(cells, speckOnly()));
+  ClearCells fresh;
+  CHECK(build(fresh, speckOnly()));
+  CHECK(std::vector<std::uint8_t>(cells.bits(), cells.bits() + before.size()) ==
+        std::vector<std::uint8_t>(fresh.bits(), fresh.bits() + before.size()));
+  CHECK(std::vector<std::uint8_t>(cells.bits(), cells.bits() + before.size()) != before);
+}
+
 TEST_CASE("no clear cells for a float brick or a table without a transparent end") {
   const Brick floats = makeVolume(cubeGrid(24), ScalarType::kFloat32, speckAndBlob);
   CHECK(clearCellsOf(floats, speckOnly()).bits() == nullptr);
