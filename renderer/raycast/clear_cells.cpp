@@ -56,132 +56,180 @@ inline void orRow(std::vector<std::uint64_t>& bits, std::int64_t at, const std::
 // How a block of cells stands against the ends, from its nodes' bounds.
 enum class Block : std::uint8_t { kNoneClear, kAllClear, kRead };
 
+// The bits of a brick's stored cells, by blocks of kSize^3 cells aligned
+// as macrocells are. A block that is one of the brick's macrocells, all of
+// whose stored cells the brick owns, takes its class from the macrocell's
+// node bounds (macrocell_bounds.h): the ends are half-lines of values (the
+// table coordinate is linear in the value), so its nodes all lie in one
+// end when the least and the greatest both do, and none does when neither
+// does. Every other block (ghost cells, no bounds) is read node by node.
+// A plane of blocks is independent of the others (plane()).
 template <typename T>
-void buildTyped(const ClearEnds& ends, const KernelParams& p, const MacrocellBounds* bounds,
-                std::vector<std::uint64_t>& bits, ThreadPool* pool) {
-  const T* v = static_cast<const T*>(p.voxels);
-  // nodeClass of every value of T (8 or 16 bits), by its offset from the least.
-  constexpr std::int64_t kLeast = std::numeric_limits<T>::min();
-  std::vector<std::uint8_t> classOf(std::size_t(1) << (8 * sizeof(T)));
-  for (std::size_t n = 0; n < classOf.size(); ++n) classOf[n] = nodeClass(T(kLeast + std::int64_t(n)), ends);
-  const std::uint8_t* cls = classOf.data();
-  auto classOfValue = [cls](T value) { return cls[std::int64_t(value) - kLeast]; };
-  constexpr int kShift = MacrocellLayout::kShift, kSize = MacrocellLayout::kSize;
-  const int lo[3] = {p.storedCellLo[0], p.storedCellLo[1], p.storedCellLo[2]};
-  const int hi[3] = {p.storedCellHi[0], p.storedCellHi[1], p.storedCellHi[2]};
-  // Blocks of kSize^3 cells aligned as macrocells are, over the stored cells.
-  int firstBlock[3], blocks[3];
-  for (int a = 0; a < 3; ++a) {
-    firstBlock[a] = lo[a] >> kShift;
-    blocks[a] = (hi[a] >> kShift) - firstBlock[a] + 1;
+class BlockBits {
+ public:
+  static constexpr int kShift = MacrocellLayout::kShift, kSize = MacrocellLayout::kSize;
+
+  BlockBits(const ClearEnds& ends, const KernelParams& p, const MacrocellBounds* bounds,
+            std::vector<std::uint64_t>& bits)
+      : p_(p), bounds_(bounds), bits_(bits), classOf_(std::size_t(1) << (8 * sizeof(T))) {
+    for (std::size_t n = 0; n < classOf_.size(); ++n) classOf_[n] = nodeClass(T(kLeast + std::int64_t(n)), ends);
+    for (int a = 0; a < 3; ++a) {
+      lo_[a] = p.storedCellLo[a];
+      hi_[a] = p.storedCellHi[a];
+      firstBlock_[a] = lo_[a] >> kShift;
+      blocks_[a] = (hi_[a] >> kShift) - firstBlock_[a] + 1;
+    }
+    width_ = hi_[0] - lo_[0] + 1;
+    words_ = std::size_t(width_ + 63) / 64;
   }
-  // A block that is one of the brick's macrocells, all of whose stored
-  // cells the brick owns, takes its class from the macrocell's node bounds
-  // (macrocell_bounds.h). The ends are half-lines of values (the table
-  // coordinate is linear in the value), so the nodes all lie in one end
-  // when the least and the greatest both do, and none does when neither
-  // does. Every other block (ghost cells, no bounds) is read node by node.
-  auto blockOf = [&](int bx, int by, int bz) {
-    if (!bounds) return Block::kRead;
+
+  int firstPlane() const { return firstBlock_[2]; }
+  int planes() const { return blocks_[2]; }
+
+  // The blocks of plane bz, a row of blocks at a time: the bits of its
+  // kSize^2 rows of cells gathered in a buffer, then or-ed into the
+  // brick's. A row of blocks none of which has a clear cell costs its
+  // blocks' bounds alone.
+  void plane(int bz) const {
+    Scratch s;
+    s.rows.resize(words_ * kSize * kSize);
+    s.allClear.resize(words_);
+    s.row.resize(std::size_t(blocks_[0]));
+    const int z0 = std::max(lo_[2], bz * kSize), z1 = std::min(hi_[2], bz * kSize + kSize - 1);
+    for (int by = firstBlock_[1]; by < firstBlock_[1] + blocks_[1]; ++by) {
+      const int y0 = std::max(lo_[1], by * kSize), y1 = std::min(hi_[1], by * kSize + kSize - 1);
+      bool any = false;
+      for (int n = 0; n < blocks_[0]; ++n) {
+        s.row[std::size_t(n)] = blockOf(firstBlock_[0] + n, by, bz);
+        any |= s.row[std::size_t(n)] != Block::kNoneClear;
+      }
+      if (!any) continue;
+      markAllClear(s);
+      readBlocks(s, y0, y1, z0, z1);
+      for (int z = z0; z <= z1; ++z)
+        for (int y = y0; y <= y1; ++y)
+          orRow(bits_, p_.base + lo_[0] + std::int64_t(y) * p_.strideY + std::int64_t(z) * p_.strideZ,
+                &s.rows[rowOf(y, z) * words_], width_);
+    }
+  }
+
+ private:
+  static constexpr std::int64_t kLeast = std::numeric_limits<T>::min();
+
+  // A row of blocks' bits and what it takes to make them.
+  struct NodeMasks {
+    std::uint32_t low[kSize + 1][kSize + 1], high[kSize + 1][kSize + 1];
+  };
+  struct Scratch {
+    std::vector<std::uint64_t> rows;      // kSize^2 rows of cells' bits (rowOf)
+    std::vector<std::uint64_t> allClear;  // a row's cells in blocks Block::kAllClear
+    std::vector<Block> row;               // the row's blocks
+    std::vector<int> reads;               // those read node by node
+    std::vector<NodeMasks> masks;         // their nodes
+  };
+
+  std::uint8_t classOfValue(T value) const { return classOf_[std::size_t(std::int64_t(value) - kLeast)]; }
+
+  // The buffer row of cell row (y, z) within its row of blocks.
+  static std::size_t rowOf(int y, int z) { return std::size_t((z & (kSize - 1)) * kSize + (y & (kSize - 1))); }
+
+  // The stored cells [x0, x1] of the row's block n along x.
+  void cellsAlongX(int n, int& x0, int& x1) const {
+    x0 = std::max(lo_[0], (firstBlock_[0] + n) * kSize);
+    x1 = std::min(hi_[0], (firstBlock_[0] + n) * kSize + kSize - 1);
+  }
+
+  Block blockOf(int bx, int by, int bz) const {
+    if (!bounds_) return Block::kRead;
     const int b[3] = {bx, by, bz};
-    const MacrocellLayout& layout = bounds->layout();
+    const MacrocellLayout& layout = bounds_->layout();
     std::int64_t index = 0;
     for (int a = 2; a >= 0; --a) {
       const std::int64_t m = b[a] - layout.first[a];
-      const bool owned = std::max(b[a] * kSize, lo[a]) >= p.ownCellLo[a] &&
-                         std::min(b[a] * kSize + kSize - 1, hi[a]) <= p.ownCellHi[a];
+      const bool owned = std::max(b[a] * kSize, lo_[a]) >= p_.ownCellLo[a] &&
+                         std::min(b[a] * kSize + kSize - 1, hi_[a]) <= p_.ownCellHi[a];
       if (m < 0 || m >= layout.count[a] || !owned) return Block::kRead;
       index = index * layout.count[a] + m;
     }
-    const std::uint8_t least = classOfValue(bounds->min<T>()[index]);
-    const std::uint8_t greatest = classOfValue(bounds->max<T>()[index]);
+    const std::uint8_t least = classOfValue(bounds_->min<T>()[index]);
+    const std::uint8_t greatest = classOfValue(bounds_->max<T>()[index]);
     return (least & greatest) ? Block::kAllClear : (least | greatest) ? Block::kRead : Block::kNoneClear;
-  };
-  const int width = hi[0] - lo[0] + 1;  // cells of a row
-  const std::size_t words = std::size_t(width + 63) / 64;
-  // One plane of blocks: its rows of blocks one by one, the bits of their
-  // kSize^2 rows of cells gathered in `rows` and or-ed into `bits` a row
-  // at a time (orRow). A row of blocks none of which has a clear cell
-  // costs its blocks' bounds alone.
-  auto plane = [&](int bz) {
-    std::vector<std::uint64_t> rows(words * kSize * kSize), allClear(words);
-    std::vector<Block> row(static_cast<std::size_t>(blocks[0]));
-    struct NodeMasks {
-      std::uint32_t low[kSize + 1][kSize + 1], high[kSize + 1][kSize + 1];
-    };
-    std::vector<int> reads;  // the row's blocks read node by node
-    std::vector<NodeMasks> masks;
-    auto cellsOf = [&](int n, int& x0, int& x1) {  // the stored cells of the row's block n along x
-      x0 = std::max(lo[0], (firstBlock[0] + n) * kSize);
-      x1 = std::min(hi[0], (firstBlock[0] + n) * kSize + kSize - 1);
-    };
-    const int z0 = std::max(lo[2], bz * kSize), z1 = std::min(hi[2], bz * kSize + kSize - 1);
-    for (int by = firstBlock[1]; by < firstBlock[1] + blocks[1]; ++by) {
-      const int y0 = std::max(lo[1], by * kSize), y1 = std::min(hi[1], by * kSize + kSize - 1);
-      bool any = false;
-      for (int n = 0; n < blocks[0]; ++n) {
-        row[std::size_t(n)] = blockOf(firstBlock[0] + n, by, bz);
-        any |= row[std::size_t(n)] != Block::kNoneClear;
-      }
-      if (!any) continue;
-      std::fill(allClear.begin(), allClear.end(), 0);
-      for (int n = 0; n < blocks[0]; ++n) {
-        if (row[std::size_t(n)] != Block::kAllClear) continue;
-        int x0, x1;
-        cellsOf(n, x0, x1);
-        setCells(allClear.data(), x0 - lo[0], (std::uint64_t(1) << (x1 - x0 + 1)) - 1);
-      }
-      for (int r = 0; r < kSize * kSize; ++r)
-        std::copy(allClear.begin(), allClear.end(), rows.begin() + std::ptrdiff_t(std::size_t(r) * words));
-      // The nodes of the blocks read, a row of a block's nodes as two masks
-      // (bit x: node x0 + x lies in the low end, in the high end), taken
-      // a row of nodes across every block at a time, so that the reads run
-      // forwards through memory; a cell is clear when its eight nodes
-      // share an end.
-      reads.clear();
-      for (int n = 0; n < blocks[0]; ++n)
-        if (row[std::size_t(n)] == Block::kRead) reads.push_back(n);
-      masks.resize(reads.size());
-      for (int z = z0; z <= z1 + 1; ++z)
-        for (int y = y0; y <= y1 + 1; ++y) {
-          const T* nodes = v + (p.base + std::int64_t(y) * p.strideY + std::int64_t(z) * p.strideZ);
-          for (std::size_t r = 0; r < reads.size(); ++r) {
-            int x0, x1;
-            cellsOf(reads[r], x0, x1);
-            std::uint32_t l = 0, h = 0;
-            for (int x = 0; x <= x1 - x0 + 1; ++x) {
-              const std::uint32_t c = classOfValue(nodes[x0 + x]);
-              l |= (c & 1u) << x;
-              h |= (c >> 1) << x;
-            }
-            masks[r].low[z - z0][y - y0] = l;
-            masks[r].high[z - z0][y - y0] = h;
+  }
+
+  // Every buffer row starts as the cells of the row's blocks that are
+  // clear whole.
+  void markAllClear(Scratch& s) const {
+    std::fill(s.allClear.begin(), s.allClear.end(), 0);
+    for (int n = 0; n < blocks_[0]; ++n) {
+      if (s.row[std::size_t(n)] != Block::kAllClear) continue;
+      int x0, x1;
+      cellsAlongX(n, x0, x1);
+      setCells(s.allClear.data(), x0 - lo_[0], (std::uint64_t(1) << (x1 - x0 + 1)) - 1);
+    }
+    for (int r = 0; r < kSize * kSize; ++r)
+      std::copy(s.allClear.begin(), s.allClear.end(), s.rows.begin() + std::ptrdiff_t(std::size_t(r) * words_));
+  }
+
+  // The cells of the blocks read node by node: a row of a block's nodes
+  // as two masks (bit x: node x0 + x lies in the low end, in the high
+  // end), taken a row of nodes across every such block at a time, so that
+  // the reads run forwards through memory; a cell is clear when its eight
+  // nodes share an end.
+  void readBlocks(Scratch& s, int y0, int y1, int z0, int z1) const {
+    s.reads.clear();
+    for (int n = 0; n < blocks_[0]; ++n)
+      if (s.row[std::size_t(n)] == Block::kRead) s.reads.push_back(n);
+    s.masks.resize(s.reads.size());
+    const T* v = static_cast<const T*>(p_.voxels);
+    for (int z = z0; z <= z1 + 1; ++z)
+      for (int y = y0; y <= y1 + 1; ++y) {
+        const T* nodes = v + (p_.base + std::int64_t(y) * p_.strideY + std::int64_t(z) * p_.strideZ);
+        for (std::size_t r = 0; r < s.reads.size(); ++r) {
+          int x0, x1;
+          cellsAlongX(s.reads[r], x0, x1);
+          std::uint32_t l = 0, h = 0;
+          for (int x = 0; x <= x1 - x0 + 1; ++x) {
+            const std::uint32_t c = classOfValue(nodes[x0 + x]);
+            l |= (c & 1u) << x;
+            h |= (c >> 1) << x;
           }
+          s.masks[r].low[z - z0][y - y0] = l;
+          s.masks[r].high[z - z0][y - y0] = h;
         }
-      for (std::size_t r = 0; r < reads.size(); ++r) {
-        int x0, x1;
-        cellsOf(reads[r], x0, x1);
-        const NodeMasks& m = masks[r];
-        const std::uint32_t cellsOfRow = (1u << (x1 - x0 + 1)) - 1;
-        for (int z = 0; z <= z1 - z0; ++z)
-          for (int y = 0; y <= y1 - y0; ++y) {
-            const std::uint32_t l = m.low[z][y] & m.low[z][y + 1] & m.low[z + 1][y] & m.low[z + 1][y + 1];
-            const std::uint32_t h = m.high[z][y] & m.high[z][y + 1] & m.high[z + 1][y] & m.high[z + 1][y + 1];
-            const int at = (z0 - bz * kSize + z) * kSize + (y0 - by * kSize + y);
-            setCells(rows.data() + std::size_t(at) * words, x0 - lo[0], ((l & (l >> 1)) | (h & (h >> 1))) & cellsOfRow);
-          }
       }
-      for (int z = z0; z <= z1; ++z)
-        for (int y = y0; y <= y1; ++y) {
-          const std::uint64_t* cells = rows.data() + std::size_t((z - bz * kSize) * kSize + (y - by * kSize)) * words;
-          orRow(bits, p.base + lo[0] + std::int64_t(y) * p.strideY + std::int64_t(z) * p.strideZ, cells, width);
+    for (std::size_t r = 0; r < s.reads.size(); ++r) {
+      int x0, x1;
+      cellsAlongX(s.reads[r], x0, x1);
+      const NodeMasks& m = s.masks[r];
+      const std::uint32_t cellsOfRow = (1u << (x1 - x0 + 1)) - 1;
+      for (int z = 0; z <= z1 - z0; ++z)
+        for (int y = 0; y <= y1 - y0; ++y) {
+          const std::uint32_t l = m.low[z][y] & m.low[z][y + 1] & m.low[z + 1][y] & m.low[z + 1][y + 1];
+          const std::uint32_t h = m.high[z][y] & m.high[z][y + 1] & m.high[z + 1][y] & m.high[z + 1][y + 1];
+          setCells(&s.rows[rowOf(y0 + y, z0 + z) * words_], x0 - lo_[0],
+                   ((l & (l >> 1)) | (h & (h >> 1))) & cellsOfRow);
         }
     }
-  };
+  }
+
+  const KernelParams& p_;
+  const MacrocellBounds* bounds_;
+  std::vector<std::uint64_t>& bits_;
+  std::vector<std::uint8_t> classOf_;  // nodeClass of every value of T, by its offset from the least
+  int lo_[3], hi_[3];                  // the stored cells
+  int firstBlock_[3], blocks_[3];
+  int width_;                          // cells of a row
+  std::size_t words_;                  // 64-bit words of a buffer row
+};
+
+template <typename T>
+void buildTyped(const ClearEnds& ends, const KernelParams& p, const MacrocellBounds* bounds,
+                std::vector<std::uint64_t>& bits, ThreadPool* pool) {
+  const BlockBits<T> blocks(ends, p, bounds, bits);
   if (pool)
-    pool->parallelFor(std::size_t(blocks[2]), [&](std::size_t n, int) { plane(firstBlock[2] + int(n)); });
+    pool->parallelFor(std::size_t(blocks.planes()), [&](std::size_t n, int) { blocks.plane(blocks.firstPlane() + int(n)); });
   else
-    for (int n = 0; n < blocks[2]; ++n) plane(firstBlock[2] + n);
+    for (int n = 0; n < blocks.planes(); ++n) blocks.plane(blocks.firstPlane() + n);
 }
 
 }  // namespace
