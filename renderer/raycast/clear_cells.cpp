@@ -252,7 +252,8 @@ bool ClearCells::build(const ClearEnds& ends, const KernelParams& p, const Brick
   const bool cells = extents.x > 1 && extents.y > 1 && extents.z > 1;
   // (A table's coordinates start at 0: a low end at or below 0 marks nothing.)
   const bool transparentEnd = ends.below > 0 || ends.above < FLT_MAX;
-  if (!cells || !transparentEnd || !p.indices32 || brick.type() == ScalarType::kFloat32) {
+  const bool small = brick.stored().nodeCount() <= kMaxNodes;
+  if (!cells || !transparentEnd || !small || !p.indices32 || brick.type() == ScalarType::kFloat32) {
     builtFor_ = ends;
     return true;
   }

@@ -23,6 +23,15 @@
 // float, and they have no NaN. The bit of a cell is that of the voxel index
 // (KernelParams) of its lowest node: 1/8 byte per stored voxel.
 //
+// Only for bricks of at most kMaxNodes nodes (a 512^3 brick): 1/8 byte a
+// voxel is 12.5 % of a uint8 brick, and issue 11 bounds a rank at 1.1x its
+// share of the volume (a 2048^3 rank on 8 ranks peaked at 1.08x without
+// it, 1.22x with it). Up to 2^27 nodes a rank's own ~28 MiB (MPI, the
+// libraries; a 256^3 rank peaks at 48 MiB) is already over a tenth of its
+// share, and the bits' 16 MiB at most; from 2^28 on the bound is within
+// reach and the bits would break it, for a few per cent a frame
+// (bench/results/plain.txt, section 10).
+//
 // Built on every transfer-function change, at a cost that follows the
 // visible data's surface, not the grid: a macrocell whose node bounds lie
 // in one end is marked whole and one with no node in either end is left,
@@ -63,11 +72,14 @@ struct ClearEnds {
 
 class ClearCells {
  public:
+  static constexpr std::int64_t kMaxNodes = std::int64_t(1) << 27;  // stored nodes (see above)
+
   // The cells of `brick`'s stored box (p: setBrick of this brick) whose
   // nodes all lie in one of `ends`; none for a float brick, a box without
-  // cells or no transparent end. `bounds`: the brick's macrocell bounds
-  // (MacrocellGrid::bounds()), by which whole macrocells are decided
-  // without their voxels; null reads every node (the same bits).
+  // cells or of more than kMaxNodes nodes, or no transparent end.
+  // `bounds`: the brick's macrocell bounds (MacrocellGrid::bounds()), by
+  // which whole macrocells are decided without their voxels; null reads
+  // every node (the same bits).
   // A ClearCells serves one brick, whose voxels do not change (as its
   // BrickRenderer's macrocells assume): built again for the ends of the
   // last build, it keeps its bits and returns false. So a transfer-function

@@ -159,6 +159,19 @@ TEST_CASE("a transfer function that keeps the transparent ends keeps the bits") 
   CHECK(std::vector<std::uint8_t>(cells.bits(), cells.bits() + before.size()) != before);
 }
 
+TEST_CASE("no clear cells for a brick above kMaxNodes: issue 11's memory bound has no room for them") {
+  // One node more than the limit, zero-filled (all in the low end).
+  GridGeometry grid;
+  grid.dims = {ClearCells::kMaxNodes / (256 * 256) + 1, 256, 256};
+  const Brick big(grid, ScalarType::kUInt8, grid.allNodes(), grid.allNodes());
+  REQUIRE(big.stored().nodeCount() > ClearCells::kMaxNodes);
+  CHECK(clearCellsOf(big, speckOnly()).bits() == nullptr);
+  grid.dims.x -= 1;  // at the limit
+  const Brick limit(grid, ScalarType::kUInt8, grid.allNodes(), grid.allNodes());
+  REQUIRE(limit.stored().nodeCount() == ClearCells::kMaxNodes);
+  CHECK(clearCellsOf(limit, speckOnly()).bits() != nullptr);
+}
+
 TEST_CASE("no clear cells for a float brick or a table without a transparent end") {
   const Brick floats = makeVolume(cubeGrid(24), ScalarType::kFloat32, speckAndBlob);
   CHECK(clearCellsOf(floats, speckOnly()).bits() == nullptr);
