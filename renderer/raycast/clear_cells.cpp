@@ -26,6 +26,8 @@ std::uint8_t nodeClass(T v, const ClearEnds& ends) {
   return std::uint8_t((x + margin < double(ends.below) ? 1 : 0) | (x - margin >= double(ends.above) ? 2 : 0));
 }
 
+// Ors `value` into a word of `bits`, atomically where another thread may
+// be writing that word (`shared`).
 inline void orInto(std::vector<std::uint64_t>& bits, std::int64_t word, std::uint64_t value, bool shared) {
   if (!value) return;
   if (shared) __atomic_fetch_or(&bits[std::size_t(word)], value, __ATOMIC_RELAXED);
