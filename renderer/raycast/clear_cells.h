@@ -25,7 +25,7 @@
 //
 // Only for bricks of at most kMaxNodes nodes (a 512^3 brick): 1/8 byte a
 // voxel is 12.5 % of a uint8 brick, and issue 11 bounds a rank at 1.1x its
-// share of the volume (a 2048^3 rank on 8 ranks peaked at 1.08x without
+// share of the volume (a 2048^3 rank on 8 ranks peaks at 1.09x without
 // it, 1.22x with it). Up to 2^27 nodes a rank's own ~28 MiB (MPI, the
 // libraries; a 256^3 rank peaks at 48 MiB) is already over a tenth of its
 // share, and the bits' 16 MiB at most; from 2^28 on the bound is within
