@@ -23,14 +23,15 @@
 // float, and they have no NaN. The bit of a cell is that of the voxel index
 // (KernelParams) of its lowest node: 1/8 byte per stored voxel.
 //
-// Only for bricks of at most kMaxNodes nodes (a 512^3 brick): 1/8 byte a
-// voxel is 12.5 % of a uint8 brick, and issue 11 bounds a rank at 1.1x its
-// share of the volume (a 2048^3 rank on 8 ranks peaks at 1.09x without
-// it, 1.22x with it). Up to 2^27 nodes a rank's own ~28 MiB (MPI, the
-// libraries; a 256^3 rank peaks at 48 MiB) is already over a tenth of its
-// share, and the bits' 16 MiB at most; from 2^28 on the bound is within
-// reach and the bits would break it, for a few per cent a frame
-// (bench/results/plain.txt, section 10).
+// Only for bricks of at most kMaxNodes nodes (2^25, 4 MiB of bits): the
+// bits pay while they stay in the caches. Two threads, the CT head
+// resampled to n^3 (bench/results/scale/clear_cells.md): no difference at
+// 256^3 (2 MiB of bits), 3-4 % slower a frame at 384^3 (6.75 MiB), 11 % at
+// 512^3, 15 % at 1024^3, where the bitmap's loads miss as the voxels' do.
+// And 1/8 byte a voxel is 12.5 % of a uint8 brick, against issue 11's bound
+// of 1.1x a rank's share (a 2048^3 rank on 8 ranks peaks at 1.09x without
+// the bits, 1.22x with them); up to 2^25 nodes a rank's own ~28 MiB (MPI,
+// the libraries) is over a tenth of its share already.
 //
 // Built on every transfer-function change, at a cost that follows the
 // visible data's surface, not the grid: a macrocell whose node bounds lie
@@ -72,7 +73,7 @@ struct ClearEnds {
 
 class ClearCells {
  public:
-  static constexpr std::int64_t kMaxNodes = std::int64_t(1) << 27;  // stored nodes (see above)
+  static constexpr std::int64_t kMaxNodes = std::int64_t(1) << 25;  // stored nodes (see above)
 
   // The cells of `brick`'s stored box (p: setBrick of this brick) whose
   // nodes all lie in one of `ends`; none for a float brick, a box without
