@@ -17,8 +17,8 @@
 # still one frame. Writes DIR/TAG.csv (not -name: Tk takes that one) and prints median and p90.
 #
 # With -edit tf each request is instead a transfer-function edit and a
-# frame (`set -tf ...; render frame`): the bone's points move by 0 to 40
-# Hounsfield units from request to request, so its transparent end moves
+# frame (`set -tf ...; render frame`): the preset's points (as the server
+# resolved them) move by 0 to 40 from request to request, so its transparent end moves
 # and every rank classifies its brick again (the clear cells included);
 # -edit colour recolours the points alone (the ends stay). The view stays.
 #
@@ -85,17 +85,18 @@ proc onNotify {event args} {
     }
 }
 
-# The bone's transfer function (examples/presets/ct_bone.json's points,
-# opacity per unit distance as the preset gives it) moved by `shift` HU, or
-# with its colours turned by `turn` (0 or 1).
-proc boneTf {shift turn} {
+# The session's transfer function (-preset's points as the server resolved
+# them, ::tfPoints) moved by `shift` above its first point, or with its
+# colours turned by `turn` (0 or 1).
+proc editedTf {shift turn} {
     set points {}
-    foreach {s r g b a} {-1024 0 0 0 0  200 0.55 0.35 0.25 0  300 0.85 0.75 0.6 0.1
-                         1000 1 0.95 0.85 0.6  2000 1 1 1 0.9} {
+    set first 1
+    foreach {s r g b a} $::tfPoints {
         if {$turn} {
             lassign [list $b $r $g] r g b
         }
-        lappend points [expr {$s == -1024 ? $s : $s + $shift}] $r $g $b $a
+        lappend points [expr {$first ? $s : $s + $shift}] $r $g $b $a
+        set first 0
     }
     return $points
 }
@@ -109,10 +110,10 @@ proc one {degrees} {
     set progressive [expr {$::opt(-interactive) ? [list -interactive -reduction $::opt(-reduction)] : {}}]
     set k [expr {$degrees / 7}]
     if {$::opt(-edit) eq "tf"} {
-        :bench set -tf [boneTf [expr {10 * ($k % 5)}] 0]
+        :bench set -tf [editedTf [expr {10 * ($k % 5)}] 0]
         :bench render frame {*}$progressive
     } elseif {$::opt(-edit) eq "colour"} {
-        :bench set -tf [boneTf 0 [expr {$k % 2}]]
+        :bench set -tf [editedTf 0 [expr {$k % 2}]]
         :bench render frame {*}$progressive
     } elseif {$degrees % 360 == 0} {
         :bench render frame {*}$progressive
@@ -126,6 +127,14 @@ proc one {degrees} {
     return $::current
 }
 
+if {$opt(-edit) ne "view"} {
+    # The resolved points exist once the dataset is loaded: a frame first.
+    set ::arrived 0
+    :bench render frame
+    vwait ::arrived
+    :bench wait -timeout 30
+    set ::tfPoints [dict get [dict get [:bench list status] remote] transfer_function]
+}
 foreach k {0 1 2} {
     one [expr {$k * 7}]
 }

@@ -97,9 +97,10 @@ class BlockBits {
     s.rows.resize(words_ * kSize * kSize);
     s.allClear.resize(words_);
     s.row.resize(std::size_t(blocks_[0]));
-    const int z0 = std::max(lo_[2], bz * kSize), z1 = std::min(hi_[2], bz * kSize + kSize - 1);
+    int z0, z1, y0, y1;
+    cellsOf(2, bz, z0, z1);
     for (int by = firstBlock_[1]; by < firstBlock_[1] + blocks_[1]; ++by) {
-      const int y0 = std::max(lo_[1], by * kSize), y1 = std::min(hi_[1], by * kSize + kSize - 1);
+      cellsOf(1, by, y0, y1);
       bool any = false;
       for (int n = 0; n < blocks_[0]; ++n) {
         s.row[std::size_t(n)] = blockOf(firstBlock_[0] + n, by, bz);
@@ -135,24 +136,26 @@ class BlockBits {
   // The buffer row of cell row (y, z) within its row of blocks.
   static std::size_t rowOf(int y, int z) { return std::size_t((z & (kSize - 1)) * kSize + (y & (kSize - 1))); }
 
-  // The stored cells [x0, x1] of the row's block n along x.
-  void cellsAlongX(int n, int& x0, int& x1) const {
-    x0 = std::max(lo_[0], (firstBlock_[0] + n) * kSize);
-    x1 = std::min(hi_[0], (firstBlock_[0] + n) * kSize + kSize - 1);
+  // The stored cells [c0, c1] of block b along axis a.
+  void cellsOf(int a, int b, int& c0, int& c1) const {
+    c0 = std::max(lo_[a], b * kSize);
+    c1 = std::min(hi_[a], b * kSize + kSize - 1);
   }
+  // The same for the row's block n along x.
+  void cellsAlongX(int n, int& x0, int& x1) const { cellsOf(0, firstBlock_[0] + n, x0, x1); }
 
+  // The macrocells are p_'s (setBrick: mcFirst, mcCount), of which bounds_
+  // holds the bounds.
   Block blockOf(int bx, int by, int bz) const {
     if (!bounds_) return Block::kRead;
     const int b[3] = {bx, by, bz};
-    const MacrocellLayout& layout = bounds_->layout();
-    std::int64_t index = 0;
-    for (int a = 2; a >= 0; --a) {
-      const std::int64_t m = b[a] - layout.first[a];
-      const bool owned = std::max(b[a] * kSize, lo_[a]) >= p_.ownCellLo[a] &&
-                         std::min(b[a] * kSize + kSize - 1, hi_[a]) <= p_.ownCellHi[a];
-      if (m < 0 || m >= layout.count[a] || !owned) return Block::kRead;
-      index = index * layout.count[a] + m;
+    for (int a = 0; a < 3; ++a) {
+      int c0, c1;
+      cellsOf(a, b[a], c0, c1);
+      const bool macrocell = b[a] >= p_.mcFirst[a] && b[a] < p_.mcFirst[a] + p_.mcCount[a];
+      if (!macrocell || c0 < p_.ownCellLo[a] || c1 > p_.ownCellHi[a]) return Block::kRead;
     }
+    const std::size_t index = kernel::macrocellIndex(p_, b);
     const std::uint8_t least = classOfValue(bounds_->min<T>()[index]);
     const std::uint8_t greatest = classOfValue(bounds_->max<T>()[index]);
     return (least & greatest) ? Block::kAllClear : (least | greatest) ? Block::kRead : Block::kNoneClear;
