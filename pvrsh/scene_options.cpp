@@ -325,7 +325,7 @@ const OptionRow kOptions[] = {
     {"-step", [](Apply& a) { setScalar(a, "sampling", "step", a.positive()); }, "H", "half the smallest spacing"},
     {"-preintegrated", [](Apply& a) { a.scene({{"sampling", {{"preintegrated", parseBoolean(a.option, a.value)}}}}); },
      "BOOLEAN", "off"},
-    {"-earlyterm", [](Apply& a) { setScalar(a, "sampling", "early_termination", a.positive()); }, "A", "1 (off)"},
+    {"-earlyterm", [](Apply& a) { setScalar(a, "sampling", "early_termination", a.positive()); }, "A", "0.9999 (1: off)"},
     {"-quality", setQuality, "DB", "0 (off: every region at -step)"},
     {"-shading", [](Apply& a) { a.scene({{"shading", {{"enabled", parseBoolean(a.option, a.value)}}}}); }, "BOOLEAN",
      "on for 3-D data"},

@@ -187,7 +187,8 @@ Reference computeReference(const BenchScene& scene, const ReferenceSettings& set
 }
 
 Case ownCase(const core::Scene& scene) {
-  return {scene.sampling.step, scene.sampling.preintegrated, true, scene.sampling.targetPsnr};
+  return {scene.sampling.step, scene.sampling.preintegrated, true, scene.sampling.targetPsnr,
+          scene.sampling.earlyTermination};
 }
 
 core::CameraSpec azimuth(const core::CameraSpec& camera, double degrees) {
@@ -280,6 +281,7 @@ CaseResult measureCase(const BenchScene& scene, const Case& c, const Reference& 
   options.preintegrated = c.preintegrated;
   options.skipEmpty = c.skipEmpty;
   options.targetPsnr = c.targetPsnr;
+  options.earlyTermination = c.earlyTermination;
   core::BrickRenderer renderer(scene.volume());
   renderer.classify(s.volumes.front().transfer, options);
 

@@ -79,6 +79,7 @@ struct Case {
   bool preintegrated = false;
   bool skipEmpty = true;
   double targetPsnr = 0;  // > 0: the step per region for this PSNR (sampling.target_psnr)
+  double earlyTermination = core::kDefaultEarlyTermination;  // a ray stops at this opacity; 1 = never
 };
 // The case the scene file itself asks for (its step, its pre-integration,
 // skipping on as in pvr-render).

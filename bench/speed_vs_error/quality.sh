@@ -12,16 +12,8 @@
 # (40,50,60), BENCH_ARGS (extra speed_vs_error options or scene files).
 set -euo pipefail
 
-HERE=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
-source "$HERE/../../scripts/lib/common.sh"
-BUILD=${BENCH_BUILD:-$PVR_ROOT/build-bench}
-RESULTS=$PVR_ROOT/bench/results
-SVE=$BUILD/bench/speed_vs_error/speed_vs_error
+source "$(dirname "${BASH_SOURCE[0]}")/prepare.sh"
 
-mkdir -p "$RESULTS"
-cmake -S "$PVR_ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release -DPVR_ASSERTIONS=OFF >/dev/null
-cmake --build "$BUILD" --target speed_vs_error -j2 | grep -E "error|warning" || true
-/usr/bin/python3 "$PVR_ROOT/bench/scenes/peer_blobs.py" volume "$PVR_ROOT/build/bench-data" >/dev/null
 {
   echo "# quality chosen by error, $(date -u '+%Y-%m-%d %H:%M UTC'), $(git -C "$PVR_ROOT" rev-parse --short HEAD 2>/dev/null || echo 'no git')"
   echo "# load average at start: $(cut -d' ' -f1-3 /proc/loadavg), $(nproc) cores shared with other sessions: times are noisy, samples are not"

@@ -16,6 +16,8 @@
 //       --step S renders at S voxels instead of the scene's own step, so a
 //       faster, coarser setting is timed beside its error (issue 13 compares
 //       speeds "at no larger error" than the peer's).
+//       --early-termination A stops rays at opacity A instead of the scene's
+//       sampling.early_termination (1: never; early_termination.sh).
 //       --peer-png FILE compares another renderer's 8-bit RGB frame of the
 //       scene's own view (VTK's PNG, over black, at the reference's size:
 //       pass --error-size to match) with the same reference, beside ours
@@ -78,6 +80,7 @@ struct Args {
   std::vector<double> quality;  // target PSNRs, dB
   int threads = 2, frames = 5, orbit = 0;
   double quickStep = 0;  // --quick --step: voxels instead of the scene's own step (0 = its own)
+  double quickEarlyTermination = 0;  // --quick --early-termination: instead of the scene's (0 = its own)
   double caseSeconds = 0;  // sweep: stop timing a case after this long (0 = never)
   bench::ReferenceSettings reference{256, 64, 16, PVR_BENCH_CACHE};
   std::string csv = std::string(PVR_SOURCE_DIR) + "/bench/results/speed_vs_error.csv";
@@ -89,8 +92,8 @@ struct Args {
                "usage: speed_vs_error [--threads N] [--frames N] [--error-size N] [--substeps N]\n"
                "                      [--steps A,B,...] [--quality DB,DB,...] [--case-seconds S] [--csv PATH]\n"
                "                      [--cache DIR | --no-cache] [SCENE.json ...]\n"
-               "       speed_vs_error --quick SCENE.json [--orbit K] [--step S] [--peer-png FILE [--peer-model SCENE.json]]\n"
-               "                      [same options]\n",
+               "       speed_vs_error --quick SCENE.json [--orbit K] [--step S] [--early-termination A]\n"
+               "                      [--peer-png FILE [--peer-model SCENE.json]] [same options]\n",
                why.c_str());
   std::exit(2);
 }
@@ -128,6 +131,7 @@ Args parseArgs(int argc, char** argv) {
       else if (arg == "--peer-png") a.peerPng = value();
       else if (arg == "--peer-model") a.peerModel = value();
       else if (arg == "--step") a.quickStep = parseList(arg, value()).at(0);
+      else if (arg == "--early-termination") a.quickEarlyTermination = parseList(arg, value()).at(0);
       else if (arg == "--case-seconds") a.caseSeconds = std::stod(value());
       else if (arg == "--error-size") a.reference.maxEdge = positive(value());
       else if (arg == "--substeps") a.reference.substeps = positive(value());
@@ -145,6 +149,8 @@ Args parseArgs(int argc, char** argv) {
   if (!a.quick.empty() && !a.scenes.empty()) usage("--quick takes one scene; no other scene files");
   if (a.quick.empty() && a.orbit > 0) usage("--orbit goes with --quick");
   if (a.quick.empty() && a.quickStep > 0) usage("--step goes with --quick (the sweep takes --steps)");
+  if (a.quick.empty() && a.quickEarlyTermination > 0) usage("--early-termination goes with --quick");
+  if (a.quickEarlyTermination > 1) usage("--early-termination must be in (0, 1]");
   if (a.quick.empty() && !a.peerPng.empty()) usage("--peer-png goes with --quick");
   if (a.peerPng.empty() && !a.peerModel.empty()) usage("--peer-model goes with --peer-png");
   if (a.scenes.empty())
@@ -181,10 +187,11 @@ int runQuick(const Args& args) {
   const core::Scene& s = scene.scene();
   Case c = bench::ownCase(s);
   if (args.quickStep > 0) c.step = args.quickStep * scene.voxel();
-  std::printf("%s: %s, %dx%d, step %.3g voxel, %s, skipping on, %s, %d threads\n",
+  if (args.quickEarlyTermination > 0) c.earlyTermination = args.quickEarlyTermination;
+  std::printf("%s: %s, %dx%d, step %.3g voxel, %s, skipping on, %s, early termination %.6g, %d threads\n",
               args.quick.c_str(), scene.describe().c_str(), s.image.width, s.image.height,
               c.step / scene.voxel(), c.preintegrated ? "pre-integrated" : "plain",
-              s.shading.enabled ? "shaded" : "unshaded", pool.size());
+              s.shading.enabled ? "shaded" : "unshaded", c.earlyTermination, pool.size());
   const Reference ref = bench::computeReference(scene, args.reference, pool);
   printReference(ref, scene);
   const double orbit = args.orbit > 0 ? kOrbitDegrees : 0;
@@ -194,8 +201,9 @@ int runQuick(const Args& args) {
   std::printf("  time per frame     %.4f s (median of %d%s; min %.4f, max %.4f; load %.2f)\n",
               t.median, t.frames, args.orbit > 0 ? ", turning 5 degrees per frame" : "", t.min,
               t.max, r.load1);
-  std::printf("  samples per second %.1f M total, %.1f M per core (%d threads)\n",
-              t.samplesPerSecond() * 1e-6, t.samplesPerSecond() * 1e-6 / pool.size(), pool.size());
+  std::printf("  samples per second %.1f M total, %.1f M per core (%d threads); %.2f M a frame\n",
+              t.samplesPerSecond() * 1e-6, t.samplesPerSecond() * 1e-6 / pool.size(), pool.size(),
+              t.frames > 0 ? double(t.samples) / t.frames * 1e-6 : 0.0);
   std::printf("  error vs reference RMSE %.3e, PSNR %.2f dB, max abs %.3e (linear RGBA at %dx%d)\n",
               r.error.rmse, r.error.psnr, r.error.maxAbs, ref.size.width, ref.size.height);
   if (!args.peerPng.empty()) {
@@ -243,7 +251,7 @@ std::vector<SweepCase> sweepCases(const Args& args, const BenchScene& scene) {
   for (double steps : args.steps)
     for (bool pre : pres)
       for (bool skip : skips) {
-        const Case c{steps * scene.voxel(), pre, skip};
+        const Case c{steps * scene.voxel(), pre, skip, 0, own.earlyTermination};
         const bool isOwn = std::abs(c.step - own.step) <= 1e-6 * own.step &&
                            pre == own.preintegrated && skip == own.skipEmpty;
         ownFound |= isOwn;
@@ -371,7 +379,8 @@ void runQuality(const Args& args, const BenchScene& scene, const Reference& ref,
   std::printf("  %-9s %9s %-4s %9s %12s %9s %12s %8s %8s %5s\n", "target dB", "PSNR dB", "met", "s/frame",
               "samples", "uniform s", "uniform samp", "time x", "samp x", "load");
   for (double target : args.quality) {
-    const SweepCase sc{{scene.scene().sampling.step, false, true, target}, false};
+    const SweepCase sc{{scene.scene().sampling.step, false, true, target, scene.scene().sampling.earlyTermination},
+                       false};
     const CaseResult r = bench::measureCase(scene, sc.c, ref, args.frames, args.caseSeconds, 0, pool);
     const UniformCost uniform = uniformCostAt(rows, r.error.psnr);
     const double samples = r.timing.frames > 0 ? double(r.timing.samples) / r.timing.frames : 0.0;
@@ -402,9 +411,9 @@ int runSweep(const Args& args) {
     }
     const BenchScene scene(path);
     const core::Scene& s = scene.scene();
-    std::printf("\n%s: %s, %dx%d, %s, %d threads\n", shortName(path).c_str(),
+    std::printf("\n%s: %s, %dx%d, %s, early termination %.6g, %d threads\n", shortName(path).c_str(),
                 scene.describe().c_str(), s.image.width, s.image.height,
-                s.shading.enabled ? "shaded" : "unshaded", pool.size());
+                s.shading.enabled ? "shaded" : "unshaded", s.sampling.earlyTermination, pool.size());
     std::fflush(stdout);
     const Reference ref = bench::computeReference(scene, args.reference, pool);
     printReference(ref, scene);

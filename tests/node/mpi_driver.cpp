@@ -129,7 +129,19 @@ Scene sceneFor(const std::string& volumeFile, const CameraSpec& camera, bool den
   s.image.width = 56;
   s.image.height = 48;
   s.shading.enabled = true;  // central differences need ghost layers
+  // Exact equality needs early termination off: each brick stops its own
+  // part of a ray (terminationBound()).
+  s.sampling.earlyTermination = 1;
   return s;
+}
+
+// How far ranks' frames may be from one process's under the default early
+// termination: each brick stops its own part of a ray once that part's
+// opacity reaches a_max, and one process stops the whole ray, so each
+// leaves out at most 1 - a_max of the light behind (lit colours, ambient +
+// diffuse + specular, stay below 2), once per brick along the ray.
+double terminationBound(int bricksAlongRay) {
+  return kTolerance + 2.0 * (bricksAlongRay + 1) * (1 - kDefaultEarlyTermination);
 }
 
 // The single-process render: what pvr-render does.
@@ -191,6 +203,23 @@ int matrix(comm::Communicator& comm, const fs::path& dir) {
         }
         check(comm, result.readPartially, label + ": ranks did not read their own bricks");
       }
+  }
+
+  // Under the default early termination, within its bound of the single-process render.
+  for (const View& view : views(grid)) {
+    Scene scene = sceneFor(rawFile, view.camera, true);
+    scene.sampling.earlyTermination = kDefaultEarlyTermination;
+    const node::FrameResult result = node::renderFrame(scene, {}, comm);
+    ++frames;
+    if (comm.rank() == 0) {
+      const double diff = maxAbsDifference(result.image, renderSerial(scene));
+      std::printf("early termination, %d ranks, %s, dense: max abs difference %.2e (bound %.2e)\n", n,
+                  view.name.c_str(), diff, terminationBound(n));
+      check(comm, diff <= terminationBound(n),
+            "early termination " + std::to_string(kDefaultEarlyTermination) + ", dense, " + view.name + ", " +
+                std::to_string(n) + " ranks: max abs difference " + std::to_string(diff) + " above " +
+                std::to_string(terminationBound(n)));
+    }
   }
 
   // The scatter path (gzip: rank 0 reads and sends bricks) renders alike.

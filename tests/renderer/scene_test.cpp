@@ -143,7 +143,7 @@ TEST_CASE("a scene with only a volume takes the defaults of scene.h", "[scene]")
   CHECK(s.image.height == d.image.height);
   CHECK(s.image.background == d.image.background);
   CHECK(s.sampling.step == 0);
-  CHECK(s.sampling.earlyTermination == 1);
+  CHECK(s.sampling.earlyTermination == kDefaultEarlyTermination);
   CHECK_FALSE(s.sampling.preintegrated);
   CHECK_FALSE(s.shading.enabled);
   CHECK(s.shading.ambient == d.shading.ambient);
