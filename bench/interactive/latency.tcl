@@ -2,7 +2,7 @@
 #
 #   pvrsh latency.tcl -host HOST:PORT ?-frames 50? ?-ranks 2? ?-shading 1?
 #                     ?-preset TF.json? ?-size 512? ?-out DIR? ?-tag latency?
-#                     ?-interactive 0? ?-reduction 4? ?-edit view?
+#                     ?-interactive 0? ?-reduction 4? ?-edit view? ?-earlyterm A?
 #
 # A photo in a label on screen receives the frames (`:s image window`). For
 # each of -frames single frames of the CT head (after 3 warm-up frames) it
@@ -30,7 +30,8 @@
 package require Tk
 
 array set opt {-host "" -frames 50 -ranks 2 -shading 1 -preset "" -size 512 -out . -tag latency
-               -dataset ct_head_cranium/ct_head_cranium.json -interactive 0 -reduction 4 -edit view}
+               -dataset ct_head_cranium/ct_head_cranium.json -interactive 0 -reduction 4 -edit view
+               -earlyterm ""}
 foreach {k v} $argv {
     if {![info exists opt($k)]} {
         puts stderr "latency.tcl: unknown option $k"
@@ -60,6 +61,9 @@ pvr_session :bench
 set settings [list -dataset $opt(-dataset) -imagesz $size,$size -shading $opt(-shading)]
 if {$opt(-preset) ne ""} {
     lappend settings -tfpreset $opt(-preset)
+}
+if {$opt(-earlyterm) ne ""} {
+    lappend settings -earlyterm $opt(-earlyterm)
 }
 :bench set {*}$settings
 

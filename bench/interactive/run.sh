@@ -11,7 +11,8 @@
 # reporting request-to-first-pixels and request-to-full-quality),
 # PVR_BENCH_REDUCTION (4: the coarse frame's pixels per axis), PVR_BENCH_EDIT
 # (view: the view turns each request; tf: the transfer function moves; colour:
-# its colours change).
+# its colours change), PVR_BENCH_EARLYTERM (the scene's early termination
+# opacity; empty: the default).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -42,4 +43,5 @@ run=()
   -frames "${PVR_BENCH_FRAMES:-50}" -ranks "${PVR_BENCH_RANKS:-2}" -shading "${PVR_BENCH_SHADING:-1}" \
   -preset "$root/examples/presets/ct_bone.json" -out "$out" -tag "${PVR_BENCH_NAME:-latency}" \
   -interactive "${PVR_BENCH_INTERACTIVE:-0}" -reduction "${PVR_BENCH_REDUCTION:-4}" -edit "${PVR_BENCH_EDIT:-view}" \
+  -earlyterm "${PVR_BENCH_EARLYTERM:-}" \
   | tee "$out/${PVR_BENCH_NAME:-latency}.txt"
