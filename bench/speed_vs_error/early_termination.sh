@@ -35,7 +35,7 @@ figures() {
     END                  { if (t != "") print t, m, r, p, x }'
 }
 
-median() { tr ' ' '\n' | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
+source "$HERE/../lib/median.sh"  # median_of
 
 {
   echo "# early ray termination, $(date -u '+%Y-%m-%d %H:%M UTC'), $(git -C "$PVR_ROOT" rev-parse --short HEAD 2>/dev/null || echo 'no git')"
@@ -57,7 +57,7 @@ median() { tr ' ' '\n' | sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[
     done
     base_t="" base_m=""
     for a in "${THRESHOLDS[@]}"; do
-      t=$(echo ${times[$a]} | median)
+      t=$(echo ${times[$a]} | median_of)
       read -r m r p x <<< "${rest[$a]}"
       [[ -z $base_t ]] && base_t=$t base_m=$m
       printf '%-18s %-8s %9.4f %8.2f %10.2f %8.2f %10.3e %8.2f\n' "$name" "$a" "$t" \

@@ -88,7 +88,7 @@ log "source $SOURCE; load average before: $LOAD_BEFORE ($(nproc) cores; other se
 # light (docs/scene.md), so its frame is also compared with the reference of
 # the scene as VTK models it (peer_blobs.py vtk-model, --peer-model).
 ROUNDS=${BENCH_VTK_ROUNDS:-3}
-median_of() { tr ' ' '\n' | grep . | sort -g | awk '{ v[NR] = $1 } END { if (NR) print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
+source "$HERE/../lib/median.sh"  # median_of
 VTK_MEDIANS=() OURS_MEDIANS=()
 VTK_PNG=$DATA/vtk_peer_own_view.png
 rm -f "$VTK_PNG"

@@ -379,8 +379,9 @@ void runQuality(const Args& args, const BenchScene& scene, const Reference& ref,
   std::printf("  %-9s %9s %-4s %9s %12s %9s %12s %8s %8s %5s\n", "target dB", "PSNR dB", "met", "s/frame",
               "samples", "uniform s", "uniform samp", "time x", "samp x", "load");
   for (double target : args.quality) {
-    const SweepCase sc{{scene.scene().sampling.step, false, true, target, scene.scene().sampling.earlyTermination},
-                       false};
+    SweepCase sc{bench::ownCase(scene.scene()), false};  // the scene's step and early termination, plain
+    sc.c.preintegrated = false;
+    sc.c.targetPsnr = target;
     const CaseResult r = bench::measureCase(scene, sc.c, ref, args.frames, args.caseSeconds, 0, pool);
     const UniformCost uniform = uniformCostAt(rows, r.error.psnr);
     const double samples = r.timing.frames > 0 ? double(r.timing.samples) / r.timing.frames : 0.0;
