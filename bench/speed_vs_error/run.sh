@@ -6,7 +6,9 @@
 # build/bench-data/, times the peer scene beside VTK's fixed-point ray caster
 # on the peer's own camera path (the two by turns, three rounds) with both
 # errors against one reference
-# (VTK's frame at the scene's own view, bench/speed_vs_error/vtk_own_view.py),
+# (VTK's frame at the scene's own view, bench/speed_vs_error/vtk_own_view.py)
+# and, in the same rounds, the per-core sample rates of the peer scene and
+# the CT head at their own settings (the targets take the rounds' median),
 # runs the sweep (table on stdout,
 # bench/results/speed_vs_error.csv), plots PSNR against time per frame
 # (bench/results/speed_vs_error.png) and ends with the targets. Everything
@@ -29,11 +31,13 @@ PEERS=${PVR_PEERS_DIR:-$(dirname "$PVR_ROOT")/shared/peers}
 PY=/usr/bin/python3  # Debian's python: numpy and VTK; not a pyenv python3 on the PATH
 SVE=$BUILD/bench/speed_vs_error/speed_vs_error
 PEER_SCENE=$PVR_ROOT/bench/scenes/peer_blobs.json
+CT_SCENE=$PVR_ROOT/examples/scenes/ct_head_bone.json
 STARTED=$(date +%s)
 
 mkdir -p "$RESULTS"
 exec > >(tee "$RESULTS/speed_vs_error.txt") 2>&1
 log() { printf '[speed_vs_error %s] %s\n' "$(date +%H:%M:%S)" "$*"; }
+per_core_rate() { sed -n 's/.*samples per second .* \([0-9.]*\) M per core.*/\1/p'; }  # from --quick's output
 
 # ---------------------------------------------------------------- packages
 apt_install() {  # packages...; never removes anything (python3-vtk9 conflicts with python3-paraview)
@@ -89,7 +93,7 @@ log "source $SOURCE; load average before: $LOAD_BEFORE ($(nproc) cores; other se
 # the scene as VTK models it (peer_blobs.py vtk-model, --peer-model).
 ROUNDS=${BENCH_VTK_ROUNDS:-3}
 source "$HERE/../lib/median.sh"  # median_of
-VTK_MEDIANS=() OURS_MEDIANS=()
+VTK_MEDIANS=() OURS_MEDIANS=() PEER_RATES=() CT_RATES=()
 VTK_PNG=$DATA/vtk_peer_own_view.png
 rm -f "$VTK_PNG"
 vtk_round() {  # round number -> VTK's median appended to VTK_MEDIANS, or VTK_NOTE set
@@ -125,6 +129,12 @@ for ((round = 1; round <= OURS_ROUNDS; round++)); do
   OUT=$("$SVE" --quick "$PEER_SCENE" --orbit 20 --threads 2 "${PEER_PNG_ARGS[@]}" | tee /dev/stderr)
   OURS_MEDIANS+=("$(echo "$OUT" | sed -n 's/.*time per frame *\([0-9.]*\) s.*/\1/p')")
   ((round > 1)) || OURS_OUT=$OUT
+  # The two per-core rate targets at the scenes' own settings and views,
+  # in the same rounds: one sweep case each was a single measurement on a
+  # shared host, and their verdicts moved by more than the margins.
+  log "peer scene and CT head at their own settings, per-core rates, round $round of $OURS_ROUNDS"
+  PEER_RATES+=("$("$SVE" --quick "$PEER_SCENE" --threads 2 --frames 20 | tee /dev/stderr | per_core_rate)")
+  CT_RATES+=("$("$SVE" --quick "$CT_SCENE" --threads 2 --frames 20 | tee /dev/stderr | per_core_rate)")
 done
 VTK_MEDIAN=$(echo "${VTK_MEDIANS[*]}" | median_of)
 OURS_ORBIT=$(echo "${OURS_MEDIANS[*]}" | median_of)
@@ -193,9 +203,16 @@ for row in "${COARSE[@]}"; do
     'BEGIN { printf "  %-62s %.2fx\n", sprintf("at step %s voxel: %.4f s, 8-bit %.2f dB (%s VTK%s)", st, o, p,
              (p >= vp) ? ">=" : "<", (p >= vm) ? ", even on its own model" : ""), v / o }'
 done
-printf "%-64s %s\n" "unshaded M samples/s per core, peer scene own (target 200)" "$(or_na "$(own peer_blobs 18)")"
+rates() {  # the rounds' rates -> "median (round 1, round 2, ...)"
+  local m
+  m=$(echo "$*" | median_of)
+  [ -n "$m" ] && echo "$m (rounds: $*)" || echo "n/a"
+}
+printf "%-64s %s\n" "unshaded M samples/s per core, peer scene own (target 200)" "$(rates "${PEER_RATES[@]}")"
+printf "%-64s %s\n" "  the sweep's case at the same settings" "$(or_na "$(own peer_blobs 18)")"
 printf "%-64s %s\n" "  best unshaded case of the sweep" "$(best 0)"
-printf "%-64s %s\n" "shaded M samples/s per core, CT head own (target 80)" "$(or_na "$(own ct_head_bone 18)")"
+printf "%-64s %s\n" "shaded M samples/s per core, CT head own (target 80)" "$(rates "${CT_RATES[@]}")"
+printf "%-64s %s\n" "  the sweep's case at the same settings" "$(or_na "$(own ct_head_bone 18)")"
 printf "%-64s %s\n" "  best shaded case of the sweep" "$(best 1)"
 printf "%-64s %s\n" "CT head s/frame, 512x512, step 0.5 voxel, shaded (target < 0.15)" "$(or_na "$(own ct_head_bone 13)")"
 echo "PSNR at each scene file's own settings, real volumes (target >= 45 dB):"
