@@ -151,11 +151,14 @@ std::vector<float> specularTable(double shininess) {
 
 namespace {
 
-// Three coordinates and a spare lane, for a ray's set-up: its ten
-// divisions (by the spacing, then the reciprocals) as three vector
-// divisions. Each lane is the same IEEE operation as the scalar one, so
-// the bits are those of the per-axis loop this replaced, at a third of
-// the divider's time (ray set-up was 5 % of a shaded CT head frame).
+// Three coordinates and a spare lane, for a ray's set-up: its divisions
+// (by the spacing, the reciprocals, the half vector's normalisation) as
+// vector divisions. Each lane is the same IEEE operation as the scalar
+// one, so the bits are those of the per-axis code this replaced (images
+// identical), in less time: 19 -> 14 ns a ray unshaded, 29 -> 21 ns
+// shaded, where set-up had been 5 % of a shaded CT head frame. A lane
+// whose step is 0 divides by 0 too, and the select drops its infinity
+// (nothing here traps floating-point exceptions).
 using Lanes = double __attribute__((vector_size(32)));
 
 Lanes lanes(const Vec3& v, double spare) { return Lanes{v.x, v.y, v.z, spare}; }
