@@ -37,7 +37,9 @@ STARTED=$(date +%s)
 mkdir -p "$RESULTS"
 exec > >(tee "$RESULTS/speed_vs_error.txt") 2>&1
 log() { printf '[speed_vs_error %s] %s\n' "$(date +%H:%M:%S)" "$*"; }
-per_core_rate() { sed -n 's/.*samples per second .* \([0-9.]*\) M per core.*/\1/p'; }  # from --quick's output
+# Figures from speed_vs_error --quick's output.
+frame_seconds() { sed -n 's/.*time per frame *\([0-9.]*\) s.*/\1/p'; }
+per_core_rate() { sed -n 's/.*samples per second .* \([0-9.]*\) M per core.*/\1/p'; }
 
 # ---------------------------------------------------------------- packages
 apt_install() {  # packages...; never removes anything (python3-vtk9 conflicts with python3-paraview)
@@ -127,7 +129,7 @@ for ((round = 1; round <= OURS_ROUNDS; round++)); do
   ((round == 1)) || [ -n "$VTK_NOTE" ] || vtk_round "$round"
   log "peer scene, our ray caster, 2 threads, the peer's camera path, round $round of $OURS_ROUNDS"
   OUT=$("$SVE" --quick "$PEER_SCENE" --orbit 20 --threads 2 "${PEER_PNG_ARGS[@]}" | tee /dev/stderr)
-  OURS_MEDIANS+=("$(echo "$OUT" | sed -n 's/.*time per frame *\([0-9.]*\) s.*/\1/p')")
+  OURS_MEDIANS+=("$(echo "$OUT" | frame_seconds)")
   ((round > 1)) || OURS_OUT=$OUT
   # The two per-core rate targets at the scenes' own settings and views,
   # in the same rounds: one sweep case each was a single measurement on a
@@ -148,7 +150,7 @@ COARSE=()  # "step seconds psnr8" per coarser step
 for step in 1 2; do
   log "peer scene, our ray caster at step $step voxel, the peer's camera path"
   OUT=$("$SVE" --quick "$PEER_SCENE" --orbit 20 --threads 2 --step "$step" "${PEER_PNG_ARGS[@]:0:2}" | tee /dev/stderr)
-  COARSE+=("$step $(echo "$OUT" | sed -n 's/.*time per frame *\([0-9.]*\) s.*/\1/p') \
+  COARSE+=("$step $(echo "$OUT" | frame_seconds) \
 $(echo "$OUT" | sed -n 's/.*our 8-bit error .*PSNR \([0-9.]*\) dB.*/\1/p')")
 done
 
